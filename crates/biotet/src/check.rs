@@ -1,0 +1,1 @@
+//! The validity checker (filled in below).

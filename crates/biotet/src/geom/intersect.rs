@@ -1,0 +1,1 @@
+//! Exact intersection tests built from orientation predicates.

@@ -1,0 +1,18 @@
+//! biotet: tetrahedral meshes from closed triangulated surfaces.
+//!
+//! The library follows the dissertation in `shared/seed` (template node deployment, LAST RESORT
+//! boundary recovery and solid-angle smoothing). This crate holds the shared ground: the mesh
+//! types ([`SurfaceMesh`], [`TetMesh`], [`TriMesh`]), the exact predicates every combinatorial
+//! decision goes through ([`geom::predicates`]), the quality metrics ([`quality`]) and the
+//! validity checks ([`check`], [`mesh::validate`]).
+#![warn(missing_docs)]
+#![deny(rustdoc::broken_intra_doc_links)]
+
+pub mod check;
+pub mod geom;
+pub mod mesh;
+pub mod quality;
+
+pub use mesh::surface::SurfaceMesh;
+pub use mesh::tet::{NO_NEIGHBOR, TET_FACES, TetMesh};
+pub use mesh::tri::{TRI_EDGES, TriMesh};

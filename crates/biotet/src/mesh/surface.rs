@@ -1,0 +1,115 @@
+//! Triangulated surfaces: the boundaries and internal interfaces a volume mesh must keep.
+
+/// A triangle surface with the region label on each side of every triangle.
+///
+/// `sides[t] = [back, front]`: `front` is the region on the side the triangle's normal points to
+/// (the normal of `(b - a) × (c - a)` for `triangles[t] = [a, b, c]`), `back` the region behind
+/// it. Label 0 is the outside. A single closed, outward-oriented surface of region 1 has
+/// `sides[t] = [1, 0]` for every triangle; an interface between regions 1 and 2 is an ordinary
+/// triangle with `[1, 2]` or `[2, 1]`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SurfaceMesh {
+    /// Point coordinates.
+    pub points: Vec<[f64; 3]>,
+    /// Three point indices per triangle.
+    pub triangles: Vec<[u32; 3]>,
+    /// Region labels behind and in front of each triangle.
+    pub sides: Vec<[u32; 2]>,
+}
+
+impl SurfaceMesh {
+    /// A closed boundary of one region: every triangle gets `[label, 0]`.
+    pub fn closed(points: Vec<[f64; 3]>, triangles: Vec<[u32; 3]>, label: u32) -> SurfaceMesh {
+        let sides = vec![[label, 0]; triangles.len()];
+        SurfaceMesh {
+            points,
+            triangles,
+            sides,
+        }
+    }
+
+    /// Number of triangles.
+    pub fn n_triangles(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// The three corner coordinates of triangle `t`.
+    #[inline]
+    pub fn corners(&self, t: usize) -> [[f64; 3]; 3] {
+        let v = self.triangles[t];
+        [
+            self.points[v[0] as usize],
+            self.points[v[1] as usize],
+            self.points[v[2] as usize],
+        ]
+    }
+
+    /// Reverse the orientation of triangle `t` (swapping its two side labels with it).
+    pub fn flip_triangle(&mut self, t: usize) {
+        self.triangles[t].swap(1, 2);
+        self.sides[t].swap(0, 1);
+    }
+
+    /// The distinct non-zero region labels, sorted.
+    pub fn regions(&self) -> Vec<u32> {
+        let mut r: Vec<u32> = self.sides.iter().flatten().copied().filter(|&l| l != 0).collect();
+        r.sort_unstable();
+        r.dedup();
+        r
+    }
+
+    /// Append another surface (points are not merged).
+    pub fn append(&mut self, other: &SurfaceMesh) {
+        let off = self.points.len() as u32;
+        self.points.extend_from_slice(&other.points);
+        self.triangles
+            .extend(other.triangles.iter().map(|t| [t[0] + off, t[1] + off, t[2] + off]));
+        self.sides.extend_from_slice(&other.sides);
+    }
+
+    /// Merge points with exactly equal coordinates (as STL needs), keeping the first occurrence's
+    /// index order; returns the number of points removed. Deterministic.
+    pub fn weld_exact(&mut self) -> usize {
+        let n = self.points.len();
+        let mut order: Vec<u32> = (0..n as u32).collect();
+        let key = |p: &[f64; 3]| [p[0].to_bits(), p[1].to_bits(), p[2].to_bits()];
+        // -0.0 and 0.0 are the same point: normalise before comparing bits.
+        for p in &mut self.points {
+            for c in p.iter_mut() {
+                if *c == 0.0 {
+                    *c = 0.0;
+                }
+            }
+        }
+        order.sort_unstable_by_key(|&i| (key(&self.points[i as usize]), i));
+        let mut rep = vec![0u32; n];
+        let mut i = 0;
+        while i < n {
+            let mut j = i + 1;
+            while j < n && key(&self.points[order[j] as usize]) == key(&self.points[order[i] as usize]) {
+                j += 1;
+            }
+            for k in i..j {
+                rep[order[k] as usize] = order[i];
+            }
+            i = j;
+        }
+        // Renumber survivors in first-occurrence order.
+        let mut new_id = vec![u32::MAX; n];
+        let mut pts = Vec::new();
+        for v in 0..n {
+            if rep[v] == v as u32 {
+                new_id[v] = pts.len() as u32;
+                pts.push(self.points[v]);
+            }
+        }
+        for t in &mut self.triangles {
+            for v in t.iter_mut() {
+                *v = new_id[rep[*v as usize] as usize];
+            }
+        }
+        let removed = n - pts.len();
+        self.points = pts;
+        removed
+    }
+}

@@ -1,0 +1,148 @@
+//! Tetrahedral meshes.
+
+/// Marks "no tet across this face" in [`TetMesh::neighbors`] (a boundary face).
+pub const NO_NEIGHBOR: u32 = u32::MAX;
+
+/// The face opposite local vertex `i` of a tet, as local vertex indices ordered so that the face
+/// is counter-clockwise seen from outside the tet (its normal points away from vertex `i`) when
+/// the tet is positively oriented. This is the one face table of the whole crate.
+pub const TET_FACES: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
+
+/// The six edges of a tet as local vertex pairs; edge `e` is opposite edge `5 - e`.
+pub const TET_EDGES: [[usize; 2]; 6] = [[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]];
+
+/// A tetrahedral mesh: points, positively oriented tets, face adjacency and a region label per
+/// tet.
+///
+/// `neighbors[t][i]` is the tet across the face opposite local vertex `i` of tet `t` (see
+/// [`TET_FACES`]), or [`NO_NEIGHBOR`] on the boundary. Keep it in step with `tets` by calling
+/// [`TetMesh::rebuild_neighbors`] after editing connectivity by hand.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TetMesh {
+    /// Point coordinates.
+    pub points: Vec<[f64; 3]>,
+    /// Four point indices per tet, positively oriented (positive signed volume).
+    pub tets: Vec<[u32; 4]>,
+    /// Tet across each face, [`NO_NEIGHBOR`] for none.
+    pub neighbors: Vec<[u32; 4]>,
+    /// Region label per tet (a material or tissue id; 0 is reserved for "outside").
+    pub labels: Vec<u32>,
+}
+
+impl TetMesh {
+    /// A mesh from points, tets and labels; adjacency is computed. Faces shared by more than two
+    /// tets keep only one pairing (the validity checker reports them).
+    ///
+    /// # Panics
+    /// If `labels` and `tets` differ in length.
+    pub fn new(points: Vec<[f64; 3]>, tets: Vec<[u32; 4]>, labels: Vec<u32>) -> TetMesh {
+        assert_eq!(tets.len(), labels.len(), "one label per tet");
+        let mut m = TetMesh {
+            points,
+            tets,
+            neighbors: Vec::new(),
+            labels,
+        };
+        m.rebuild_neighbors();
+        m
+    }
+
+    /// Number of tets.
+    pub fn n_tets(&self) -> usize {
+        self.tets.len()
+    }
+
+    /// Number of points.
+    pub fn n_points(&self) -> usize {
+        self.points.len()
+    }
+
+    /// The four corner coordinates of tet `t`.
+    #[inline]
+    pub fn corners(&self, t: usize) -> [[f64; 3]; 4] {
+        let v = self.tets[t];
+        [
+            self.points[v[0] as usize],
+            self.points[v[1] as usize],
+            self.points[v[2] as usize],
+            self.points[v[3] as usize],
+        ]
+    }
+
+    /// Global vertex indices of face `f` of tet `t`, oriented outward (see [`TET_FACES`]).
+    #[inline]
+    pub fn face(&self, t: usize, f: usize) -> [u32; 3] {
+        let v = self.tets[t];
+        let l = TET_FACES[f];
+        [v[l[0]], v[l[1]], v[l[2]]]
+    }
+
+    /// The distinct region labels, sorted.
+    pub fn regions(&self) -> Vec<u32> {
+        let mut r = self.labels.clone();
+        r.sort_unstable();
+        r.dedup();
+        r
+    }
+
+    /// Recompute [`TetMesh::neighbors`] from [`TetMesh::tets`]. Returns the number of faces found
+    /// in more than two tets (left unpaired beyond the first two).
+    pub fn rebuild_neighbors(&mut self) -> usize {
+        let (nb, over) = face_adjacency(&self.tets);
+        self.neighbors = nb;
+        over
+    }
+
+    /// Boundary faces (no tet across), each as `(tet, local face)`.
+    pub fn boundary_faces(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        self.neighbors.iter().enumerate().flat_map(|(t, nb)| {
+            (0..4).filter_map(move |f| (nb[f] == NO_NEIGHBOR).then_some((t, f)))
+        })
+    }
+}
+
+/// A face key: the sorted vertex triple.
+#[inline]
+pub(crate) fn sorted3(mut f: [u32; 3]) -> [u32; 3] {
+    if f[0] > f[1] {
+        f.swap(0, 1);
+    }
+    if f[1] > f[2] {
+        f.swap(1, 2);
+    }
+    if f[0] > f[1] {
+        f.swap(0, 1);
+    }
+    f
+}
+
+/// Face adjacency of a tet array by sorting face keys: `(neighbors, faces in more than two
+/// tets)`. O(n log n), no hashing, deterministic.
+pub fn face_adjacency(tets: &[[u32; 4]]) -> (Vec<[u32; 4]>, usize) {
+    let mut keys: Vec<([u32; 3], u32)> = Vec::with_capacity(tets.len() * 4);
+    for (t, v) in tets.iter().enumerate() {
+        for (f, l) in TET_FACES.iter().enumerate() {
+            keys.push((sorted3([v[l[0]], v[l[1]], v[l[2]]]), (t as u32) << 2 | f as u32));
+        }
+    }
+    keys.sort_unstable();
+    let mut nb = vec![[NO_NEIGHBOR; 4]; tets.len()];
+    let mut over = 0;
+    let mut i = 0;
+    while i < keys.len() {
+        let mut j = i + 1;
+        while j < keys.len() && keys[j].0 == keys[i].0 {
+            j += 1;
+        }
+        if j - i >= 2 {
+            let (a, b) = (keys[i].1, keys[i + 1].1);
+            nb[(a >> 2) as usize][(a & 3) as usize] = b >> 2;
+            nb[(b >> 2) as usize][(b & 3) as usize] = a >> 2;
+            if j - i > 2 {
+                over += 1;
+            }
+        }
+        i = j;
+    }
+    (nb, over)
+}

@@ -1,0 +1,1 @@
+//! Whole-mesh quality reports (filled in by the quality work).

@@ -1,0 +1,134 @@
+//! Per-tet measures: dihedral angles, solid angles, q (eq. 4.9 of the seed) and radius ratio.
+
+use crate::geom::vec3::{add, cross, dot, norm, norm2, scale, sub, volume6};
+use crate::mesh::tet::TET_EDGES;
+
+/// Solid angle at each vertex of a regular tetrahedron, `3·acos(1/3) − π` steradians (eq. 4.2).
+pub const REGULAR_SOLID_ANGLE: f64 = 0.551_285_598_432_530_8;
+
+/// The six interior dihedral angles (radians) at the edges of [`TET_EDGES`], in that order.
+/// Negative-volume tets still get angles in `[0, π]`; check orientation separately.
+pub fn dihedral_angles(c: &[[f64; 3]; 4]) -> [f64; 6] {
+    // Area-weighted outward normals of the faces opposite each vertex.
+    let n = face_normals(c);
+    let mut out = [0.0; 6];
+    for (e, &[i, j]) in TET_EDGES.iter().enumerate() {
+        // The two faces at edge ij are those opposite the other two vertices k, l.
+        let [k, l] = TET_EDGES[5 - e];
+        debug_assert!(k != i && k != j && l != i && l != j);
+        let (nk, nl) = (n[k], n[l]);
+        // Interior angle = π − angle between outward normals.
+        out[e] = norm(cross(nk, nl)).atan2(-dot(nk, nl));
+    }
+    out
+}
+
+/// Outward normals (length = twice the face area) of the faces opposite each vertex, for a
+/// positively oriented tet.
+fn face_normals(c: &[[f64; 3]; 4]) -> [[f64; 3]; 4] {
+    let f = crate::mesh::tet::TET_FACES;
+    let mut n = [[0.0; 3]; 4];
+    for (i, l) in f.iter().enumerate() {
+        let (a, b, cc) = (c[l[0]], c[l[1]], c[l[2]]);
+        n[i] = cross(sub(b, a), sub(cc, a));
+    }
+    n
+}
+
+/// The four solid angles (steradians) at the vertices, by the Van Oosterom–Strackee formula.
+/// Negative for an inverted tet.
+pub fn solid_angles(c: &[[f64; 3]; 4]) -> [f64; 4] {
+    let det = volume6(c[0], c[1], c[2], c[3]);
+    let mut out = [0.0; 4];
+    for (i, o) in out.iter_mut().enumerate() {
+        let others: Vec<usize> = (0..4).filter(|&j| j != i).collect();
+        let u = sub(c[others[0]], c[i]);
+        let v = sub(c[others[1]], c[i]);
+        let w = sub(c[others[2]], c[i]);
+        let (lu, lv, lw) = (norm(u), norm(v), norm(w));
+        let denom = lu * lv * lw + dot(u, v) * lw + dot(u, w) * lv + dot(v, w) * lu;
+        // det(u, v, w) has the same sign for every vertex once the vertex is moved to the front
+        // with an even permutation; vertices 1 and 3 need an odd one.
+        let s = if i % 2 == 0 { det } else { -det };
+        *o = 2.0 * s.atan2(denom);
+    }
+    out
+}
+
+/// Signed volume of the tet.
+pub fn volume(c: &[[f64; 3]; 4]) -> f64 {
+    volume6(c[0], c[1], c[2], c[3]) / 6.0
+}
+
+/// q = 12·(3V)^(2/3) / ΣL² (eq. 4.9): 1 for the regular tet, 0 for a flat one, negative for an
+/// inverted one.
+pub fn q_measure(c: &[[f64; 3]; 4]) -> f64 {
+    let v = volume(c);
+    let l2: f64 = TET_EDGES.iter().map(|&[i, j]| norm2(sub(c[i], c[j]))).sum();
+    if l2 == 0.0 {
+        return 0.0;
+    }
+    v.signum() * 12.0 * (3.0 * v.abs()).powf(2.0 / 3.0) / l2
+}
+
+/// Radius ratio 3·r_in / R_circ: 1 for the regular tet, 0 for a flat one, negative when inverted.
+pub fn radius_ratio(c: &[[f64; 3]; 4]) -> f64 {
+    let det = volume6(c[0], c[1], c[2], c[3]);
+    if det == 0.0 {
+        return 0.0;
+    }
+    let n = face_normals(c);
+    let area: f64 = n.iter().map(|x| 0.5 * norm(*x)).sum();
+    let r_in = (det.abs() / 2.0) / area; // 3V / A
+    let (u, v, w) = (sub(c[1], c[0]), sub(c[2], c[0]), sub(c[3], c[0]));
+    let num = add(
+        add(scale(cross(v, w), norm2(u)), scale(cross(w, u), norm2(v))),
+        scale(cross(u, v), norm2(w)),
+    );
+    let r_circ = norm(num) / (2.0 * det.abs());
+    det.signum() * 3.0 * r_in / r_circ
+}
+
+/// Every measure of one tet at once.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TetMeasures {
+    /// Dihedral angles in degrees, at the edges of [`TET_EDGES`].
+    pub dihedral_deg: [f64; 6],
+    /// Solid angles in steradians at the four vertices.
+    pub solid_sr: [f64; 4],
+    /// q of eq. 4.9.
+    pub q: f64,
+    /// Radius ratio.
+    pub radius_ratio: f64,
+    /// Signed volume.
+    pub volume: f64,
+}
+
+impl TetMeasures {
+    /// Measure the tet with corners `c`.
+    pub fn of(c: &[[f64; 3]; 4]) -> TetMeasures {
+        let d = dihedral_angles(c);
+        TetMeasures {
+            dihedral_deg: d.map(f64::to_degrees),
+            solid_sr: solid_angles(c),
+            q: q_measure(c),
+            radius_ratio: radius_ratio(c),
+            volume: volume(c),
+        }
+    }
+
+    /// Smallest dihedral angle (degrees).
+    pub fn min_dihedral(&self) -> f64 {
+        self.dihedral_deg.iter().copied().fold(f64::INFINITY, f64::min)
+    }
+
+    /// Largest dihedral angle (degrees).
+    pub fn max_dihedral(&self) -> f64 {
+        self.dihedral_deg.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    /// Smallest solid angle (steradians).
+    pub fn min_solid(&self) -> f64 {
+        self.solid_sr.iter().copied().fold(f64::INFINITY, f64::min)
+    }
+}
