@@ -1,1 +1,62 @@
-fn main() {}
+//! The `biotet` command-line tool.
+//!
+//! Conventions shared by every command: `biotet <command> INPUT... [-o OUT]`, `--help`
+//! everywhere, `--quiet` silences everything but errors, `--json` prints one JSON object on
+//! stdout for scripts, a progress spinner on a terminal, errors as one message without a
+//! backtrace, outputs written to a temporary file and renamed.
+
+mod cmd;
+mod plot;
+mod progress;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// biotet: tetrahedral meshes from closed triangulated surfaces, keeping the surface exactly.
+#[derive(Parser)]
+#[command(name = "biotet", version, about, long_about = None, propagate_version = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+/// Options every command takes.
+#[derive(clap::Args, Clone, Copy, Debug, Default)]
+pub struct Common {
+    /// Print nothing but errors (and the JSON object with --json).
+    #[arg(short, long, global = true)]
+    pub quiet: bool,
+    /// Print one JSON object on stdout instead of text.
+    #[arg(long, global = true)]
+    pub json: bool,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Report the quality of a tet (or 2D triangle) mesh: angles, q, radius ratio, histograms.
+    Quality(cmd::quality::Args),
+    /// Check that a tet mesh is valid and, with --surface, that it contains every surface
+    /// triangle. Exits 0 only when valid.
+    Check(cmd::check::Args),
+    /// Convert a mesh between formats (chosen by extension).
+    Convert(cmd::convert::Args),
+    /// Validate closed surfaces: closed, manifold, consistently oriented, no self-intersection.
+    Validate(cmd::validate::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Quality(a) => cmd::quality::run(a),
+        Command::Check(a) => cmd::check::run(a),
+        Command::Convert(a) => cmd::convert::run(a),
+        Command::Validate(a) => cmd::validate::run(a),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

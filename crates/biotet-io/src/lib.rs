@@ -1,1 +1,400 @@
-//! Readers and writers.
+//! Readers and writers for the mesh files biotet reads and writes.
+//!
+//! | kind | formats (extension, case-insensitive) | read | write |
+//! |---|---|---|---|
+//! | surface ([`SurfaceMesh`]) | STL `.stl` (ASCII/binary), OBJ `.obj`, OFF `.off`, PLY `.ply` (ASCII/binary LE/BE), Medit `.mesh` | ✓ | ✓ |
+//! | tet mesh ([`TetMesh`]) | VTU `.vtu`, Medit `.mesh`, Gmsh `.msh` (4.1 ASCII/binary, 2.2 ASCII), TetGen `.node`/`.ele`(/`.face`) | ✓ | ✓ |
+//! | 2D mesh ([`TriMesh`]) | Medit `.mesh` (`Dimension 2`), Triangle `.node`/`.ele` | ✓ | ✓ |
+//!
+//! The path-based entry points ([`read_surface`], [`write_surface`], [`read_tet_mesh`],
+//! [`write_tet_mesh`], [`read_tri_mesh`], [`write_tri_mesh`]) choose the format by extension;
+//! [`mesh_kind`] tells which kind of mesh a path holds (peeking into `.mesh` and `.node`
+//! files). Each format module also has stream-based functions (`read`/`parse`/`write`, generic
+//! over [`std::io::Read`]/[`std::io::Write`], taking a file name for messages) for in-memory use.
+//!
+//! Conventions shared by all formats:
+//! - Writers write shortest round-trip float text (`ryu`), so text formats are exact (binary
+//!   STL, which stores `f32`, is the one lossy format). Writers reject meshes with non-finite
+//!   coordinates or out-of-range indices ([`Error::InvalidMesh`]).
+//! - Every write is atomic ([`atomic`]): temporary file(s) next to the target, renamed when
+//!   complete; nothing is left behind on error.
+//! - Tet and triangle readers return positively oriented cells: a tet with negative volume
+//!   (by the exact [`biotet::geom::predicates::orient3d`]) gets its last two vertices swapped,
+//!   counted in [`TetRead::flipped`]; likewise clockwise triangles ([`TriRead::flipped`]).
+//! - Readers never panic on malformed input; every error names the file and the line (text) or
+//!   element index (binary) and the reason ([`Error`]).
+//! - Tet writers also store the boundary and interface faces between labels, grouped and
+//!   numbered the same way everywhere (see [`medit`]): Medit triangle refs, Gmsh 2D physical
+//!   groups `boundary_<a>_0`/`interface_<a>_<b>`, TetGen `.face` markers.
+#![warn(missing_docs)]
+
+use std::path::{Path, PathBuf};
+
+pub use biotet::{SurfaceMesh, TetMesh, TriMesh};
+
+pub mod atomic;
+mod b64;
+mod common;
+pub mod error;
+pub mod gmsh;
+pub mod medit;
+pub mod obj;
+pub mod off;
+pub mod ply;
+pub mod stl;
+pub mod tetgen;
+mod text;
+pub mod vtu;
+
+pub use error::{Error, Result};
+pub use tetgen::{TetgenFiles, TetgenOptions};
+pub use vtu::VtuEncoding;
+
+/// A surface read from a file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SurfaceRead {
+    /// The surface; every triangle has sides `[1, 0]` (a closed outward surface of region 1).
+    pub mesh: SurfaceMesh,
+    /// Per-triangle refs when the file has them (Medit triangle refs; a PLY face property named
+    /// `ref`, `label`, `region` or `marker`).
+    pub triangle_refs: Option<Vec<i32>>,
+    /// Points removed by welding exact duplicates (STL only; 0 otherwise).
+    pub welded: usize,
+    /// Polygonal faces (more than three corners) split into fans of triangles (OBJ, OFF, PLY).
+    pub polygons_split: usize,
+}
+
+/// A tet mesh read from a file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TetRead {
+    /// The mesh, every tet positively oriented (or degenerate), adjacency built.
+    pub mesh: TetMesh,
+    /// Tets that had negative volume and were fixed by swapping two vertices.
+    pub flipped: usize,
+    /// Tets of exactly zero volume (kept as they are).
+    pub degenerate: usize,
+    /// Volume elements other than linear tets (hexahedra, prisms, quadratic tets, ...) that
+    /// were ignored.
+    pub skipped_elements: usize,
+}
+
+/// A 2D triangle mesh read from a file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TriRead {
+    /// The mesh, every triangle counter-clockwise (or degenerate), adjacency built.
+    pub mesh: TriMesh,
+    /// Clockwise triangles fixed by swapping two vertices.
+    pub flipped: usize,
+    /// Triangles of exactly zero area (kept).
+    pub degenerate: usize,
+}
+
+macro_rules! deref_to_mesh {
+    ($t:ty, $m:ty) => {
+        /// Gives the mesh's fields directly (`read.points`), and lets `&read` be passed where a
+        /// mesh reference is expected.
+        impl std::ops::Deref for $t {
+            type Target = $m;
+            fn deref(&self) -> &$m {
+                &self.mesh
+            }
+        }
+    };
+}
+deref_to_mesh!(SurfaceRead, SurfaceMesh);
+deref_to_mesh!(TetRead, TetMesh);
+deref_to_mesh!(TriRead, TriMesh);
+
+/// Which kind of mesh a file holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum MeshKind {
+    /// A triangulated surface in 3D.
+    Surface,
+    /// A tetrahedral mesh.
+    Tetrahedra,
+    /// A 2D triangle mesh.
+    Triangles2d,
+}
+
+/// Surface file formats.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum SurfaceFormat {
+    /// STL; read: ASCII or binary (detected); write: binary.
+    Stl,
+    /// ASCII STL (write; reading detects).
+    StlAscii,
+    /// Wavefront OBJ.
+    Obj,
+    /// OFF.
+    Off,
+    /// PLY; read: any encoding; write: binary little endian.
+    Ply,
+    /// ASCII PLY (write; reading detects).
+    PlyAscii,
+    /// Medit `.mesh` (`Dimension 3`, `Triangles`).
+    Medit,
+}
+
+/// Tet mesh file formats.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum TetFormat {
+    /// VTK XML unstructured grid `.vtu`.
+    Vtu,
+    /// Medit `.mesh`.
+    Medit,
+    /// Gmsh `.msh` (write: 4.1 ASCII).
+    Gmsh,
+    /// Gmsh `.msh` 4.1 binary (write; reading detects).
+    GmshBinary,
+    /// TetGen `.node`/`.ele`/`.face` (see [`tetgen`] for the naming rule).
+    TetGen,
+}
+
+/// 2D triangle mesh file formats.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum TriFormat {
+    /// Medit `.mesh` with `Dimension 2`.
+    Medit,
+    /// Triangle `.node`/`.ele`.
+    Triangle,
+}
+
+/// Supported surface extensions, for messages.
+pub const SURFACE_EXTENSIONS: &str = ".stl, .obj, .off, .ply, .mesh";
+/// Supported tet mesh extensions, for messages.
+pub const TET_EXTENSIONS: &str = ".vtu, .mesh, .msh, .node/.ele (TetGen)";
+/// Supported 2D mesh extensions, for messages.
+pub const TRI_EXTENSIONS: &str = ".mesh, .node/.ele (Triangle)";
+const ALL_EXTENSIONS: &str = ".stl, .obj, .off, .ply, .mesh, .vtu, .msh, .node, .ele";
+
+/// The lower-case extension of a path.
+fn ext(path: &Path) -> String {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase())
+        .unwrap_or_default()
+}
+
+fn name(path: &Path) -> String {
+    path.display().to_string()
+}
+
+impl SurfaceFormat {
+    /// The format named by a path's extension.
+    pub fn from_path(path: &Path) -> Result<SurfaceFormat> {
+        Ok(match ext(path).as_str() {
+            "stl" => SurfaceFormat::Stl,
+            "obj" => SurfaceFormat::Obj,
+            "off" => SurfaceFormat::Off,
+            "ply" => SurfaceFormat::Ply,
+            "mesh" => SurfaceFormat::Medit,
+            _ => {
+                return Err(Error::UnknownExtension {
+                    path: name(path),
+                    kind: "surface",
+                    supported: SURFACE_EXTENSIONS,
+                });
+            }
+        })
+    }
+}
+
+impl TetFormat {
+    /// The format named by a path's extension.
+    pub fn from_path(path: &Path) -> Result<TetFormat> {
+        Ok(match ext(path).as_str() {
+            "vtu" => TetFormat::Vtu,
+            "mesh" => TetFormat::Medit,
+            "msh" => TetFormat::Gmsh,
+            "node" | "ele" | "face" => TetFormat::TetGen,
+            _ => {
+                return Err(Error::UnknownExtension {
+                    path: name(path),
+                    kind: "tet mesh",
+                    supported: TET_EXTENSIONS,
+                });
+            }
+        })
+    }
+}
+
+impl TriFormat {
+    /// The format named by a path's extension.
+    pub fn from_path(path: &Path) -> Result<TriFormat> {
+        Ok(match ext(path).as_str() {
+            "mesh" => TriFormat::Medit,
+            "node" | "ele" => TriFormat::Triangle,
+            _ => {
+                return Err(Error::UnknownExtension {
+                    path: name(path),
+                    kind: "triangle mesh",
+                    supported: TRI_EXTENSIONS,
+                });
+            }
+        })
+    }
+}
+
+/// Which kind of mesh `path` holds: by extension, looking inside `.mesh` files (their
+/// `Dimension` and whether they have tetrahedra, see [`medit::peek_kind`]) and TetGen/Triangle
+/// `.node`/`.ele` files (the dimension in the `.node` header).
+pub fn mesh_kind(path: &Path) -> Result<MeshKind> {
+    match ext(path).as_str() {
+        "stl" | "obj" | "off" | "ply" => Ok(MeshKind::Surface),
+        "vtu" | "msh" => Ok(MeshKind::Tetrahedra),
+        "mesh" => medit::peek_kind(atomic::open(path)?, &name(path)),
+        "node" | "ele" => {
+            let node = tetgen::files(path).node;
+            match tetgen::peek_dim(atomic::open(&node)?, &name(&node))? {
+                2 => Ok(MeshKind::Triangles2d),
+                _ => Ok(MeshKind::Tetrahedra),
+            }
+        }
+        _ => Err(Error::UnknownExtension {
+            path: name(path),
+            kind: "mesh",
+            supported: ALL_EXTENSIONS,
+        }),
+    }
+}
+
+/// Read a surface, choosing the format by extension.
+pub fn read_surface(path: &Path) -> Result<SurfaceRead> {
+    read_surface_as(path, SurfaceFormat::from_path(path)?)
+}
+
+/// Read a surface in the given format.
+pub fn read_surface_as(path: &Path, format: SurfaceFormat) -> Result<SurfaceRead> {
+    let data = atomic::read_file(path)?;
+    let n = name(path);
+    match format {
+        SurfaceFormat::Stl | SurfaceFormat::StlAscii => stl::parse(&data, &n),
+        SurfaceFormat::Obj => obj::parse(&data, &n),
+        SurfaceFormat::Off => off::parse(&data, &n),
+        SurfaceFormat::Ply | SurfaceFormat::PlyAscii => ply::parse(&data, &n),
+        SurfaceFormat::Medit => medit::parse_surface(&data, &n),
+    }
+}
+
+/// Write a surface, choosing the format by extension (`.stl` binary, `.ply` binary).
+pub fn write_surface(path: &Path, mesh: &SurfaceMesh) -> Result<()> {
+    write_surface_as(path, mesh, SurfaceFormat::from_path(path)?)
+}
+
+/// Write a surface in the given format, atomically.
+pub fn write_surface_as(path: &Path, mesh: &SurfaceMesh, format: SurfaceFormat) -> Result<()> {
+    let n = name(path);
+    atomic::write_atomic(path, |w| match format {
+        SurfaceFormat::Stl => stl::write_binary(w, mesh, &n),
+        SurfaceFormat::StlAscii => stl::write_ascii(w, mesh, &n),
+        SurfaceFormat::Obj => obj::write(w, mesh, &n),
+        SurfaceFormat::Off => off::write(w, mesh, &n),
+        SurfaceFormat::Ply => ply::write_binary(w, mesh, &n),
+        SurfaceFormat::PlyAscii => ply::write_ascii(w, mesh, &n),
+        SurfaceFormat::Medit => medit::write_surface(w, mesh, &n),
+    })
+}
+
+/// Read a tet mesh, choosing the format by extension (TetGen: `.node` or `.ele`, reading both).
+pub fn read_tet_mesh(path: &Path) -> Result<TetRead> {
+    read_tet_mesh_as(path, TetFormat::from_path(path)?)
+}
+
+/// Read a tet mesh in the given format.
+pub fn read_tet_mesh_as(path: &Path, format: TetFormat) -> Result<TetRead> {
+    let n = name(path);
+    match format {
+        TetFormat::Vtu => vtu::parse_tet(&atomic::read_file(path)?, &n),
+        TetFormat::Medit => medit::parse_tet(&atomic::read_file(path)?, &n),
+        TetFormat::Gmsh | TetFormat::GmshBinary => gmsh::parse_tet(&atomic::read_file(path)?, &n),
+        TetFormat::TetGen => {
+            let f = tetgen::files(path);
+            tetgen::parse_tet(
+                &atomic::read_file(&f.node)?,
+                &atomic::read_file(&f.ele)?,
+                &name(&f.base),
+            )
+        }
+    }
+}
+
+/// Write a tet mesh, choosing the format by extension; returns the files written (TetGen
+/// writes three: see [`tetgen`] for the naming rule).
+pub fn write_tet_mesh(path: &Path, mesh: &TetMesh) -> Result<Vec<PathBuf>> {
+    write_tet_mesh_as(path, mesh, TetFormat::from_path(path)?)
+}
+
+/// Write a tet mesh in the given format, atomically; returns the files written.
+pub fn write_tet_mesh_as(path: &Path, mesh: &TetMesh, format: TetFormat) -> Result<Vec<PathBuf>> {
+    let n = name(path);
+    let one = |f: &dyn Fn(&mut atomic::AtomicWriter) -> Result<()>| -> Result<Vec<PathBuf>> {
+        atomic::write_atomic(path, f)?;
+        Ok(vec![path.to_path_buf()])
+    };
+    match format {
+        TetFormat::Vtu => one(&|w| vtu::write_tet(w, mesh, &n)),
+        TetFormat::Medit => one(&|w| medit::write_tet(w, mesh, &n)),
+        TetFormat::Gmsh => one(&|w| gmsh::write_tet(w, mesh, &n)),
+        TetFormat::GmshBinary => one(&|w| gmsh::write_tet_binary(w, mesh, &n)),
+        TetFormat::TetGen => {
+            let f = tetgen::files(path);
+            let paths = vec![f.node.clone(), f.ele.clone(), f.face.clone()];
+            let base = name(&f.base);
+            atomic::write_atomic_many(&paths, |ws| {
+                let [a, b, c] = ws else {
+                    unreachable!("three writers")
+                };
+                tetgen::write_tet(a, b, Some(c), mesh, &base, TetgenOptions::default())
+            })?;
+            Ok(paths)
+        }
+    }
+}
+
+/// Read a 2D triangle mesh, choosing the format by extension.
+pub fn read_tri_mesh(path: &Path) -> Result<TriRead> {
+    read_tri_mesh_as(path, TriFormat::from_path(path)?)
+}
+
+/// Read a 2D triangle mesh in the given format.
+pub fn read_tri_mesh_as(path: &Path, format: TriFormat) -> Result<TriRead> {
+    match format {
+        TriFormat::Medit => medit::parse_tri(&atomic::read_file(path)?, &name(path)),
+        TriFormat::Triangle => {
+            let f = tetgen::files(path);
+            tetgen::parse_tri(
+                &atomic::read_file(&f.node)?,
+                &atomic::read_file(&f.ele)?,
+                &name(&f.base),
+            )
+        }
+    }
+}
+
+/// Write a 2D triangle mesh, choosing the format by extension; returns the files written.
+pub fn write_tri_mesh(path: &Path, mesh: &TriMesh) -> Result<Vec<PathBuf>> {
+    write_tri_mesh_as(path, mesh, TriFormat::from_path(path)?)
+}
+
+/// Write a 2D triangle mesh in the given format, atomically; returns the files written
+/// (Triangle: `base.node` and `base.ele`, named as in [`tetgen`]).
+pub fn write_tri_mesh_as(path: &Path, mesh: &TriMesh, format: TriFormat) -> Result<Vec<PathBuf>> {
+    match format {
+        TriFormat::Medit => {
+            atomic::write_atomic(path, |w| medit::write_tri(w, mesh, &name(path)))?;
+            Ok(vec![path.to_path_buf()])
+        }
+        TriFormat::Triangle => {
+            let f = tetgen::files(path);
+            let paths = vec![f.node.clone(), f.ele.clone()];
+            let base = name(&f.base);
+            atomic::write_atomic_many(&paths, |ws| {
+                let [a, b] = ws else {
+                    unreachable!("two writers")
+                };
+                tetgen::write_tri(a, b, mesh, &base, TetgenOptions::default())
+            })?;
+            Ok(paths)
+        }
+    }
+}

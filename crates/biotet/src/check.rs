@@ -1,1 +1,519 @@
-//! The validity checker (filled in below).
+//! The validity checker: is a [`TetMesh`] a conforming, positively oriented tetrahedralization,
+//! and does it contain every triangle of a given surface?
+//!
+//! Every decision is exact: orientation by [`orient3d`], surface matching by exact coordinates.
+//! Every test that makes a mesh runs this on it; `biotet check` prints its report.
+
+use crate::geom::predicates::{Sign, orient3d};
+use crate::mesh::surface::SurfaceMesh;
+use crate::mesh::tet::{NO_NEIGHBOR, TET_FACES, TetMesh, sorted3};
+use rustc_hash::FxHashMap;
+use serde::Serialize;
+use std::fmt;
+
+/// How many offending items of each kind are listed by name in [`CheckReport::problems`].
+const LIST_FIRST: usize = 5;
+
+/// The result of [`check`]: counts of each kind of defect and the first offenders of each.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct CheckReport {
+    /// True when no defect was found.
+    pub valid: bool,
+    /// Points in the mesh.
+    pub n_points: usize,
+    /// Tets in the mesh.
+    pub n_tets: usize,
+    /// Boundary faces (faces of exactly one tet).
+    pub n_boundary_faces: usize,
+    /// Tets with a vertex index out of range or a repeated vertex.
+    pub n_bad_tets: usize,
+    /// Tets that are not strictly positively oriented (exact orient3d ≤ 0).
+    pub n_nonpositive: usize,
+    /// Faces found in more than two tets.
+    pub n_overshared_faces: usize,
+    /// Interior faces whose two tets give them the same orientation (the tets overlap).
+    pub n_misoriented_faces: usize,
+    /// Entries of the adjacency array that disagree with the faces.
+    pub n_adjacency_errors: usize,
+    /// Points used by no tet.
+    pub n_unused_points: usize,
+    /// Points with exactly the same coordinates as an earlier point.
+    pub n_duplicate_points: usize,
+    /// Non-finite coordinates.
+    pub n_nonfinite_points: usize,
+    /// Label array length differs from the tet count (0 or 1).
+    pub n_label_errors: usize,
+    /// Surface conformity, when a surface was given.
+    pub surface: Option<SurfaceConformity>,
+    /// Human-readable descriptions of the first offenders of each kind.
+    pub problems: Vec<String>,
+}
+
+/// How a [`TetMesh`] conforms to a [`SurfaceMesh`].
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct SurfaceConformity {
+    /// Surface triangles.
+    pub n_triangles: usize,
+    /// Surface triangles present as mesh faces with the right neighbours and labels.
+    pub n_found: usize,
+    /// Surface triangles with a corner that is not a mesh point.
+    pub n_points_missing: usize,
+    /// Surface triangles whose three corners are mesh points but that are no mesh face.
+    pub n_missing: usize,
+    /// Outer triangles (one side labelled 0) present as faces but not on the mesh boundary.
+    pub n_outer_not_boundary: usize,
+    /// Interface triangles present as faces but not between tets of their two labels.
+    pub n_interface_wrong: usize,
+    /// Triangles whose adjacent tet labels contradict the triangle's side labels.
+    pub n_label_mismatch: usize,
+    /// Mesh boundary faces that are no outer surface triangle.
+    pub n_extra_boundary_faces: usize,
+    /// Per pair of side labels (sorted, 0 = outside): expected and found triangles.
+    pub interfaces: Vec<InterfaceConformity>,
+}
+
+/// Expected and found triangles of one boundary or interface (a pair of region labels).
+#[derive(Debug, Clone, Default, Serialize, PartialEq, Eq)]
+pub struct InterfaceConformity {
+    /// The two region labels, smaller first (0 = outside, so `[0, r]` is region r's boundary).
+    pub labels: [u32; 2],
+    /// Triangles of the surface with these side labels.
+    pub expected: usize,
+    /// Of those, present in the mesh as required.
+    pub found: usize,
+}
+
+impl CheckReport {
+    fn note(&mut self, count: usize, msg: impl FnOnce() -> String) {
+        if count <= LIST_FIRST {
+            self.problems.push(msg());
+        }
+    }
+}
+
+/// Exact coordinate key (so `-0.0 == 0.0`).
+#[inline]
+fn coord_key(p: &[f64; 3]) -> [u64; 3] {
+    p.map(|c| if c == 0.0 { 0 } else { c.to_bits() })
+}
+
+/// Check `mesh`, and if `surface` is given, that every surface triangle is a face of it.
+///
+/// Mesh checks: indices in range and distinct, every tet strictly positive (exact), no face in
+/// more than two tets, the two tets of an interior face see it with opposite orientations, the
+/// adjacency array matches the faces, every point used, no duplicate or non-finite points, one
+/// label per tet. Surface checks (points matched by exact coordinates): every triangle is a mesh
+/// face; triangles with an outside side (label 0) are boundary faces and, when the mesh has
+/// several regions, the tet behind them carries the inside label; interface triangles lie
+/// between tets of their two labels, each on its side; no other boundary faces exist.
+pub fn check(mesh: &TetMesh, surface: Option<&SurfaceMesh>) -> CheckReport {
+    let mut r = CheckReport {
+        n_points: mesh.points.len(),
+        n_tets: mesh.tets.len(),
+        ..Default::default()
+    };
+    let np = mesh.points.len();
+
+    if mesh.labels.len() != mesh.tets.len() {
+        r.n_label_errors = 1;
+        r.problems.push(format!(
+            "{} labels for {} tets",
+            mesh.labels.len(),
+            mesh.tets.len()
+        ));
+    }
+    for (i, p) in mesh.points.iter().enumerate() {
+        if !p.iter().all(|c| c.is_finite()) {
+            r.n_nonfinite_points += 1;
+            r.note(r.n_nonfinite_points, || {
+                format!("point {i} is not finite: {p:?}")
+            });
+        }
+    }
+
+    // Tets: indices and orientation.
+    let mut ok_tet = vec![true; mesh.tets.len()];
+    let mut used = vec![false; np];
+    for (t, v) in mesh.tets.iter().enumerate() {
+        let in_range = v.iter().all(|&i| (i as usize) < np);
+        let distinct = v[0] != v[1] && v[0] != v[2] && v[0] != v[3] && v[1] != v[2];
+        let distinct = distinct && v[1] != v[3] && v[2] != v[3];
+        if !in_range || !distinct {
+            ok_tet[t] = false;
+            r.n_bad_tets += 1;
+            r.note(r.n_bad_tets, || {
+                format!("tet {t} {v:?}: vertex index out of range ({np} points) or repeated")
+            });
+            continue;
+        }
+        for &i in v {
+            used[i as usize] = true;
+        }
+        let c = mesh.corners(t);
+        if orient3d(c[0], c[1], c[2], c[3]) != Sign::Positive {
+            r.n_nonpositive += 1;
+            r.note(r.n_nonpositive, || {
+                format!("tet {t} {v:?} is not positively oriented: corners {c:?}")
+            });
+        }
+    }
+    for (i, u) in used.iter().enumerate() {
+        if !u {
+            r.n_unused_points += 1;
+            r.note(r.n_unused_points, || {
+                format!("point {i} {:?} is used by no tet", mesh.points[i])
+            });
+        }
+    }
+    let mut first_at: FxHashMap<[u64; 3], usize> = FxHashMap::default();
+    first_at.reserve(np);
+    for (i, p) in mesh.points.iter().enumerate() {
+        if let Some(&j) = first_at.get(&coord_key(p)) {
+            r.n_duplicate_points += 1;
+            r.note(r.n_duplicate_points, || {
+                format!("point {i} duplicates point {j} at {p:?}")
+            });
+        } else {
+            first_at.insert(coord_key(p), i);
+        }
+    }
+
+    // Faces: sort (key, tet*4 + face) and walk the runs.
+    let mut keys: Vec<([u32; 3], u32)> = Vec::with_capacity(mesh.tets.len() * 4);
+    for (t, v) in mesh.tets.iter().enumerate() {
+        if !ok_tet[t] {
+            continue;
+        }
+        for (f, l) in TET_FACES.iter().enumerate() {
+            keys.push((
+                sorted3([v[l[0]], v[l[1]], v[l[2]]]),
+                (t as u32) << 2 | f as u32,
+            ));
+        }
+    }
+    keys.sort_unstable();
+    let mut expect_nb = vec![[NO_NEIGHBOR; 4]; mesh.tets.len()];
+    let mut boundary: FxHashMap<[u32; 3], (u32, u32)> = FxHashMap::default();
+    let mut i = 0;
+    while i < keys.len() {
+        let mut j = i + 1;
+        while j < keys.len() && keys[j].0 == keys[i].0 {
+            j += 1;
+        }
+        let key = keys[i].0;
+        match j - i {
+            1 => {
+                let (t, f) = (keys[i].1 >> 2, keys[i].1 & 3);
+                boundary.insert(key, (t, f));
+            }
+            2 => {
+                let (a, b) = (keys[i].1, keys[i + 1].1);
+                let (ta, fa) = ((a >> 2) as usize, (a & 3) as usize);
+                let (tb, fb) = ((b >> 2) as usize, (b & 3) as usize);
+                expect_nb[ta][fa] = tb as u32;
+                expect_nb[tb][fb] = ta as u32;
+                if same_cyclic_order(mesh.face(ta, fa), mesh.face(tb, fb)) {
+                    r.n_misoriented_faces += 1;
+                    r.note(r.n_misoriented_faces, || {
+                        format!("face {key:?} has the same orientation in tets {ta} and {tb}: they overlap")
+                    });
+                }
+            }
+            n => {
+                r.n_overshared_faces += 1;
+                let tets: Vec<u32> = keys[i..j].iter().map(|k| k.1 >> 2).collect();
+                r.note(r.n_overshared_faces, || {
+                    format!("face {key:?} is in {n} tets {tets:?}")
+                });
+            }
+        }
+        i = j;
+    }
+    r.n_boundary_faces = boundary.len();
+
+    // Adjacency.
+    if mesh.neighbors.len() != mesh.tets.len() {
+        r.n_adjacency_errors += 1;
+        r.problems.push(format!(
+            "adjacency has {} entries for {} tets",
+            mesh.neighbors.len(),
+            mesh.tets.len()
+        ));
+    } else {
+        for (t, nb) in mesh.neighbors.iter().enumerate() {
+            if !ok_tet[t] {
+                continue;
+            }
+            for f in 0..4 {
+                if nb[f] != expect_nb[t][f] {
+                    r.n_adjacency_errors += 1;
+                    r.note(r.n_adjacency_errors, || {
+                        format!(
+                            "tet {t} face {f}: adjacency says {}, faces say {}",
+                            show_nb(nb[f]),
+                            show_nb(expect_nb[t][f])
+                        )
+                    });
+                }
+            }
+        }
+    }
+
+    if let Some(s) = surface {
+        r.surface = Some(check_surface(
+            mesh,
+            s,
+            &first_at,
+            &keys,
+            &boundary,
+            &mut r.problems,
+        ));
+    }
+
+    let s_ok = r.surface.as_ref().is_none_or(|s| {
+        s.n_found == s.n_triangles && s.n_extra_boundary_faces == 0 && s.n_label_mismatch == 0
+    });
+    r.valid = s_ok
+        && r.n_bad_tets == 0
+        && r.n_nonpositive == 0
+        && r.n_overshared_faces == 0
+        && r.n_misoriented_faces == 0
+        && r.n_adjacency_errors == 0
+        && r.n_unused_points == 0
+        && r.n_duplicate_points == 0
+        && r.n_nonfinite_points == 0
+        && r.n_label_errors == 0;
+    r
+}
+
+fn show_nb(n: u32) -> String {
+    if n == NO_NEIGHBOR {
+        "none".to_string()
+    } else {
+        format!("tet {n}")
+    }
+}
+
+/// True when `a` and `b` list the same three vertices in the same cyclic order.
+fn same_cyclic_order(a: [u32; 3], b: [u32; 3]) -> bool {
+    let rot = |x: [u32; 3]| {
+        let m = (0..3).min_by_key(|&k| x[k]).unwrap_or(0);
+        [x[m], x[(m + 1) % 3], x[(m + 2) % 3]]
+    };
+    rot(a) == rot(b)
+}
+
+fn check_surface(
+    mesh: &TetMesh,
+    s: &SurfaceMesh,
+    point_of: &FxHashMap<[u64; 3], usize>,
+    face_keys: &[([u32; 3], u32)],
+    boundary: &FxHashMap<[u32; 3], (u32, u32)>,
+    problems: &mut Vec<String>,
+) -> SurfaceConformity {
+    let mut c = SurfaceConformity {
+        n_triangles: s.triangles.len(),
+        ..Default::default()
+    };
+    let multi_region = mesh.regions().len() > 1;
+    let mut per_pair: FxHashMap<[u32; 2], (usize, usize)> = FxHashMap::default();
+    let mut outer_faces_seen = 0usize;
+    let mut listed = 0usize;
+    let mut list = |problems: &mut Vec<String>, msg: String| {
+        listed += 1;
+        if listed <= 2 * LIST_FIRST {
+            problems.push(msg);
+        }
+    };
+    // Surface point -> mesh point.
+    let map: Vec<Option<u32>> = s
+        .points
+        .iter()
+        .map(|p| point_of.get(&coord_key(p)).map(|&i| i as u32))
+        .collect();
+
+    for (t, tri) in s.triangles.iter().enumerate() {
+        let sides = s.sides.get(t).copied().unwrap_or([1, 0]);
+        let pair = [sides[0].min(sides[1]), sides[0].max(sides[1])];
+        per_pair.entry(pair).or_default().0 += 1;
+        let corners = s.corners(t);
+        let Some(v) = tri
+            .iter()
+            .map(|&i| map.get(i as usize).copied().flatten())
+            .collect::<Option<Vec<u32>>>()
+        else {
+            c.n_points_missing += 1;
+            list(
+                problems,
+                format!(
+                    "surface triangle {t} {tri:?}: a corner of {corners:?} is not a mesh point"
+                ),
+            );
+            continue;
+        };
+        let fv = [v[0], v[1], v[2]];
+        let key = sorted3(fv);
+        let lo = face_keys.partition_point(|k| k.0 < key);
+        let hits: Vec<(usize, usize)> = face_keys[lo..]
+            .iter()
+            .take_while(|k| k.0 == key)
+            .map(|k| ((k.1 >> 2) as usize, (k.1 & 3) as usize))
+            .collect();
+        if hits.is_empty() {
+            c.n_missing += 1;
+            list(
+                problems,
+                format!("surface triangle {t} {tri:?} at {corners:?} is missing from the mesh"),
+            );
+            continue;
+        }
+        // For each tet at this face: is it behind the triangle (same cyclic order as the
+        // triangle, since tet faces are outward) or in front?
+        let mut ok = true;
+        let outer = sides[0] == 0 || sides[1] == 0;
+        if outer {
+            if hits.len() != 1 {
+                c.n_outer_not_boundary += 1;
+                ok = false;
+                list(
+                    problems,
+                    format!(
+                        "surface triangle {t} {tri:?} (outer boundary) is an interior face of the mesh"
+                    ),
+                );
+            }
+        } else if hits.len() != 2 {
+            c.n_interface_wrong += 1;
+            ok = false;
+            list(
+                problems,
+                format!(
+                    "surface triangle {t} {tri:?} (interface {}|{}) is a boundary face of the mesh",
+                    sides[0], sides[1]
+                ),
+            );
+        }
+        if ok && (multi_region || !outer) {
+            for &(tet, f) in &hits {
+                let behind = same_cyclic_order(mesh.face(tet, f), fv);
+                let want = if behind { sides[0] } else { sides[1] };
+                let got = mesh.labels.get(tet).copied().unwrap_or(u32::MAX);
+                if got != want {
+                    c.n_label_mismatch += 1;
+                    ok = false;
+                    list(
+                        problems,
+                        format!(
+                            "surface triangle {t} {tri:?}: tet {tet} on its {} side has label {got}, expected {want}",
+                            if behind { "back" } else { "front" }
+                        ),
+                    );
+                    break;
+                }
+            }
+        }
+        if ok {
+            c.n_found += 1;
+            per_pair.entry(pair).or_default().1 += 1;
+            if outer {
+                outer_faces_seen += 1;
+            }
+        }
+    }
+    // Boundary faces that are no outer triangle: count boundary faces minus the outer triangles
+    // that matched one (a duplicated surface triangle would be caught by surface validation).
+    c.n_extra_boundary_faces = boundary.len().saturating_sub(outer_faces_seen);
+    if c.n_extra_boundary_faces > 0 && c.n_found == c.n_triangles {
+        problems.push(format!(
+            "{} mesh boundary faces are not triangles of the surface",
+            c.n_extra_boundary_faces
+        ));
+    }
+    let mut pairs: Vec<_> = per_pair.into_iter().collect();
+    pairs.sort_unstable();
+    c.interfaces = pairs
+        .into_iter()
+        .map(|(labels, (expected, found))| InterfaceConformity {
+            labels,
+            expected,
+            found,
+        })
+        .collect();
+    c
+}
+
+impl fmt::Display for CheckReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(
+            f,
+            "{}: {} points, {} tets, {} boundary faces",
+            if self.valid { "valid" } else { "INVALID" },
+            self.n_points,
+            self.n_tets,
+            self.n_boundary_faces
+        )?;
+        let rows = [
+            ("tets with bad or repeated vertex indices", self.n_bad_tets),
+            ("tets not strictly positive", self.n_nonpositive),
+            ("faces in more than two tets", self.n_overshared_faces),
+            (
+                "interior faces with equal orientations",
+                self.n_misoriented_faces,
+            ),
+            ("adjacency entries wrong", self.n_adjacency_errors),
+            ("unused points", self.n_unused_points),
+            ("duplicate points", self.n_duplicate_points),
+            ("non-finite points", self.n_nonfinite_points),
+            ("label array errors", self.n_label_errors),
+        ];
+        for (what, n) in rows {
+            if n > 0 {
+                writeln!(f, "  {n} {what}")?;
+            }
+        }
+        if let Some(s) = &self.surface {
+            writeln!(
+                f,
+                "surface: {} of {} triangles present",
+                s.n_found, s.n_triangles
+            )?;
+            for i in &s.interfaces {
+                let name = if i.labels[0] == 0 {
+                    format!("boundary of region {}", i.labels[1])
+                } else {
+                    format!("interface {}|{}", i.labels[0], i.labels[1])
+                };
+                writeln!(f, "  {name}: {} of {} found", i.found, i.expected)?;
+            }
+            let rows = [
+                (
+                    "triangles with a corner that is no mesh point",
+                    s.n_points_missing,
+                ),
+                ("triangles missing", s.n_missing),
+                ("outer triangles inside the mesh", s.n_outer_not_boundary),
+                (
+                    "interface triangles on the mesh boundary",
+                    s.n_interface_wrong,
+                ),
+                (
+                    "triangles with wrong labels beside them",
+                    s.n_label_mismatch,
+                ),
+                (
+                    "boundary faces not on the surface",
+                    s.n_extra_boundary_faces,
+                ),
+            ];
+            for (what, n) in rows {
+                if n > 0 {
+                    writeln!(f, "  {n} {what}")?;
+                }
+            }
+        }
+        for p in &self.problems {
+            writeln!(f, "  - {p}")?;
+        }
+        Ok(())
+    }
+}

@@ -9,6 +9,7 @@
 #![deny(rustdoc::broken_intra_doc_links)]
 
 pub mod check;
+pub mod delaunay;
 pub mod geom;
 pub mod mesh;
 pub mod quality;

@@ -52,7 +52,13 @@ impl SurfaceMesh {
 
     /// The distinct non-zero region labels, sorted.
     pub fn regions(&self) -> Vec<u32> {
-        let mut r: Vec<u32> = self.sides.iter().flatten().copied().filter(|&l| l != 0).collect();
+        let mut r: Vec<u32> = self
+            .sides
+            .iter()
+            .flatten()
+            .copied()
+            .filter(|&l| l != 0)
+            .collect();
         r.sort_unstable();
         r.dedup();
         r
@@ -62,8 +68,12 @@ impl SurfaceMesh {
     pub fn append(&mut self, other: &SurfaceMesh) {
         let off = self.points.len() as u32;
         self.points.extend_from_slice(&other.points);
-        self.triangles
-            .extend(other.triangles.iter().map(|t| [t[0] + off, t[1] + off, t[2] + off]));
+        self.triangles.extend(
+            other
+                .triangles
+                .iter()
+                .map(|t| [t[0] + off, t[1] + off, t[2] + off]),
+        );
         self.sides.extend_from_slice(&other.sides);
     }
 
@@ -86,7 +96,9 @@ impl SurfaceMesh {
         let mut i = 0;
         while i < n {
             let mut j = i + 1;
-            while j < n && key(&self.points[order[j] as usize]) == key(&self.points[order[i] as usize]) {
+            while j < n
+                && key(&self.points[order[j] as usize]) == key(&self.points[order[i] as usize])
+            {
                 j += 1;
             }
             for k in i..j {

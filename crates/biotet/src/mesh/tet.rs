@@ -122,7 +122,10 @@ pub fn face_adjacency(tets: &[[u32; 4]]) -> (Vec<[u32; 4]>, usize) {
     let mut keys: Vec<([u32; 3], u32)> = Vec::with_capacity(tets.len() * 4);
     for (t, v) in tets.iter().enumerate() {
         for (f, l) in TET_FACES.iter().enumerate() {
-            keys.push((sorted3([v[l[0]], v[l[1]], v[l[2]]]), (t as u32) << 2 | f as u32));
+            keys.push((
+                sorted3([v[l[0]], v[l[1]], v[l[2]]]),
+                (t as u32) << 2 | f as u32,
+            ));
         }
     }
     keys.sort_unstable();

@@ -1,9 +1,12 @@
-//! Element quality: per-element measures ([`tet`]) and whole-mesh reports ([`report`]).
+//! Element quality: per-element measures ([`tet`] for tets, [`tri`] for 2D triangles) and
+//! whole-mesh reports ([`report`]).
 //!
 //! Measures are floating point on purpose: they rank and report, they never decide topology.
 
 pub mod report;
 pub mod tet;
+pub mod tri;
 
 pub use report::*;
 pub use tet::*;
+pub use tri::TriMeasures;

@@ -36,21 +36,24 @@ fn face_normals(c: &[[f64; 3]; 4]) -> [[f64; 3]; 4] {
 }
 
 /// The four solid angles (steradians) at the vertices, by the Van Oosterom–Strackee formula.
-/// Negative for an inverted tet.
+/// Positive for a positively oriented tet, negative for an inverted one.
 pub fn solid_angles(c: &[[f64; 3]; 4]) -> [f64; 4] {
+    /// The other three vertices of each vertex.
+    const OTHERS: [[usize; 3]; 4] = [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]];
     let det = volume6(c[0], c[1], c[2], c[3]);
     let mut out = [0.0; 4];
     for (i, o) in out.iter_mut().enumerate() {
-        let others: Vec<usize> = (0..4).filter(|&j| j != i).collect();
-        let u = sub(c[others[0]], c[i]);
-        let v = sub(c[others[1]], c[i]);
-        let w = sub(c[others[2]], c[i]);
+        let [a, b, d] = OTHERS[i];
+        let u = sub(c[a], c[i]);
+        let v = sub(c[b], c[i]);
+        let w = sub(c[d], c[i]);
         let (lu, lv, lw) = (norm(u), norm(v), norm(w));
         let denom = lu * lv * lw + dot(u, v) * lw + dot(u, w) * lv + dot(v, w) * lu;
-        // det(u, v, w) has the same sign for every vertex once the vertex is moved to the front
-        // with an even permutation; vertices 1 and 3 need an odd one.
-        let s = if i % 2 == 0 { det } else { -det };
-        *o = 2.0 * s.atan2(denom);
+        // The formula's numerator is the triple product [u v w], which is ±det: −det at vertices 1
+        // and 3, whose `OTHERS` order is an odd permutation away from the tet's. The denominator
+        // is symmetric in u, v, w, so use det itself: the same sign at every vertex, the sign of
+        // the tet's orientation.
+        *o = 2.0 * det.atan2(denom);
     }
     out
 }
@@ -119,12 +122,18 @@ impl TetMeasures {
 
     /// Smallest dihedral angle (degrees).
     pub fn min_dihedral(&self) -> f64 {
-        self.dihedral_deg.iter().copied().fold(f64::INFINITY, f64::min)
+        self.dihedral_deg
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min)
     }
 
     /// Largest dihedral angle (degrees).
     pub fn max_dihedral(&self) -> f64 {
-        self.dihedral_deg.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+        self.dihedral_deg
+            .iter()
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max)
     }
 
     /// Smallest solid angle (steradians).

@@ -1,1 +1,169 @@
-//! Tests: check.
+//! The validity checker finds each kind of defect, and only those.
+
+use crate::common::{cube_points, cube_surface, cube6, two_cubes};
+use biotet::check::check;
+use biotet::{NO_NEIGHBOR, SurfaceMesh, TetMesh};
+
+#[test]
+fn cube_is_valid_and_has_its_surface() {
+    let m = cube6();
+    let r = check(&m, Some(&cube_surface([0.0; 3], 1.0)));
+    assert!(r.valid, "{r}");
+    assert_eq!(r.n_boundary_faces, 12);
+    let s = r.surface.unwrap();
+    assert_eq!((s.n_triangles, s.n_found), (12, 12));
+}
+
+#[test]
+fn flipped_tet_is_not_positive() {
+    let mut m = cube6();
+    m.tets[2].swap(0, 1);
+    m.rebuild_neighbors();
+    let r = check(&m, None);
+    assert!(!r.valid);
+    assert_eq!(r.n_nonpositive, 1, "{r}");
+    // Its faces now have the same orientation as its neighbours' view of them.
+    assert!(r.n_misoriented_faces >= 1, "{r}");
+}
+
+#[test]
+fn flat_tet_is_not_positive() {
+    let pts = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [1.0, 1.0, 0.0],
+    ];
+    let m = TetMesh::new(pts, vec![[0, 1, 2, 3]], vec![1]);
+    let r = check(&m, None);
+    assert_eq!(r.n_nonpositive, 1);
+    assert!(!r.valid);
+}
+
+#[test]
+fn missing_tet_loses_surface_triangles() {
+    let mut m = cube6();
+    m.tets.remove(0);
+    m.labels.remove(0);
+    m.rebuild_neighbors();
+    let r = check(&m, Some(&cube_surface([0.0; 3], 1.0)));
+    // The mesh itself is still a valid (non-convex) mesh...
+    assert_eq!(
+        r.n_nonpositive + r.n_overshared_faces + r.n_adjacency_errors,
+        0
+    );
+    // ...but two cube triangles are gone and two inner faces became boundary.
+    let s = r.surface.as_ref().unwrap();
+    assert_eq!(s.n_missing, 2, "{r}");
+    assert_eq!(s.n_extra_boundary_faces, 2, "{r}");
+    assert!(!r.valid);
+}
+
+#[test]
+fn triangle_off_the_mesh_points_is_reported() {
+    let m = cube6();
+    let s = cube_surface([0.0, 0.0, 0.5], 1.0);
+    let r = check(&m, Some(&s));
+    assert!(!r.valid);
+    assert!(r.surface.unwrap().n_points_missing > 0);
+}
+
+#[test]
+fn overshared_face_is_reported() {
+    let mut m = cube6();
+    let t = m.tets[0];
+    // A second copy of tet 0: each of its faces is now in too many tets or misoriented.
+    m.tets.push(t);
+    m.labels.push(1);
+    m.rebuild_neighbors();
+    let r = check(&m, None);
+    assert!(!r.valid);
+    assert!(r.n_overshared_faces >= 1, "{r}");
+}
+
+#[test]
+fn stale_adjacency_is_reported() {
+    let mut m = cube6();
+    let f = (0..4).find(|&f| m.neighbors[0][f] != NO_NEIGHBOR).unwrap();
+    m.neighbors[0][f] = NO_NEIGHBOR;
+    let r = check(&m, None);
+    assert_eq!(r.n_adjacency_errors, 1, "{r}");
+    assert!(!r.valid);
+}
+
+#[test]
+fn unused_and_duplicate_points_are_reported() {
+    let mut m = cube6();
+    m.points.push([5.0, 5.0, 5.0]);
+    m.points.push([1.0, 1.0, 1.0]);
+    let r = check(&m, None);
+    assert_eq!(r.n_unused_points, 2, "{r}");
+    assert_eq!(r.n_duplicate_points, 1, "{r}");
+    assert!(!r.valid);
+}
+
+#[test]
+fn out_of_range_index_does_not_panic() {
+    let mut m = cube6();
+    m.tets[3][1] = 99;
+    let r = check(&m, None);
+    assert_eq!(r.n_bad_tets, 1);
+    assert!(!r.valid);
+}
+
+#[test]
+fn two_regions_with_their_interface() {
+    let m = two_cubes();
+    // Surface: the outer boundary of both cubes and the interface x = 1 between 1 and 2.
+    let left = cube_surface([0.0; 3], 1.0);
+    let right = cube_surface([1.0, 0.0, 0.0], 1.0);
+    let mut s = SurfaceMesh::default();
+    for (cube, label, x_shared) in [(&left, 1u32, 1.0), (&right, 2u32, 1.0)] {
+        let mut part = cube.clone();
+        for t in 0..part.triangles.len() {
+            let on_shared = part.corners(t).iter().all(|p| p[0] == x_shared);
+            part.sides[t] = [label, 0];
+            if on_shared {
+                // Keep the interface once, from the left cube: back = 1, front = 2.
+                part.sides[t] = if label == 1 {
+                    [1, 2]
+                } else {
+                    [u32::MAX, u32::MAX]
+                };
+            }
+        }
+        let keep: Vec<usize> = (0..part.triangles.len())
+            .filter(|&t| part.sides[t][0] != u32::MAX)
+            .collect();
+        part.triangles = keep.iter().map(|&t| part.triangles[t]).collect();
+        part.sides = keep.iter().map(|&t| part.sides[t]).collect();
+        s.append(&part);
+    }
+    let r = check(&m, Some(&s));
+    assert!(r.valid, "{r}");
+    let sc = r.surface.unwrap();
+    assert_eq!(sc.n_triangles, 22);
+    let pairs: Vec<([u32; 2], usize)> = sc.interfaces.iter().map(|i| (i.labels, i.found)).collect();
+    assert_eq!(pairs, vec![([0, 1], 10), ([0, 2], 10), ([1, 2], 2)]);
+
+    // Swapping the labels of the two cubes contradicts the interface's sides.
+    let mut swapped = m.clone();
+    for l in &mut swapped.labels {
+        *l = 3 - *l;
+    }
+    let r = check(&swapped, Some(&s));
+    assert!(!r.valid);
+    assert!(r.surface.unwrap().n_label_mismatch > 0);
+}
+
+#[test]
+fn scaled_and_shifted_cube_stays_valid() {
+    // The same fixture from 1e-9 to 1e9: exact predicates do not care about scale.
+    for &s in &[1e-9, 1e-3, 1.0, 1e3, 1e9] {
+        let pts = cube_points([s * 0.1, -s, 3.0 * s], s);
+        let mut m = cube6();
+        m.points = pts.clone();
+        let r = check(&m, Some(&cube_surface([s * 0.1, -s, 3.0 * s], s)));
+        assert!(r.valid, "scale {s}: {r}");
+    }
+}

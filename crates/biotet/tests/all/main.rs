@@ -1,6 +1,8 @@
 //! The library's integration tests: one binary, a module per topic.
 
 mod check;
+mod common;
+mod delaunay;
 mod predicates;
 mod quality;
 mod validate;

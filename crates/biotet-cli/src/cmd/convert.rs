@@ -1,0 +1,88 @@
+//! `biotet convert`: between every mesh format biotet reads and writes.
+
+use crate::{Common, progress::Stage};
+use anyhow::Result;
+use biotet_io::MeshKind;
+use serde_json::json;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Arguments of `biotet convert`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Input mesh; its format is chosen by extension.
+    input: PathBuf,
+    /// Output mesh; its format is chosen by extension (.vtu .mesh .msh .node/.ele for tets and
+    /// 2D triangles; .stl .obj .off .ply .mesh for surfaces).
+    #[arg(short, long, value_name = "OUT")]
+    output: PathBuf,
+    #[command(flatten)]
+    common: Common,
+}
+
+/// Run `biotet convert`.
+pub fn run(a: Args) -> Result<ExitCode> {
+    let stage = Stage::start(a.common.quiet, format!("reading {}", a.input.display()));
+    let kind = biotet_io::mesh_kind(&a.input)?;
+    let out_ext = a
+        .output
+        .extension()
+        .map(|e| e.to_string_lossy().to_lowercase())
+        .unwrap_or_default();
+    let surface_ext = ["stl", "obj", "off", "ply"].contains(&out_ext.as_str());
+    if surface_ext && kind != MeshKind::Surface {
+        anyhow::bail!(
+            "{}: cannot write a volume or 2D mesh as a surface (.{out_ext}); \
+             use .vtu, .mesh, .msh or .node/.ele",
+            a.output.display()
+        );
+    }
+    if kind == MeshKind::Surface && ["vtu", "msh", "node", "ele"].contains(&out_ext.as_str()) {
+        anyhow::bail!(
+            "{}: {} is a surface; write it as .stl, .obj, .off, .ply or .mesh \
+             (meshing a surface is `biotet mesh`, coming with the mesher)",
+            a.output.display(),
+            a.input.display()
+        );
+    }
+    let (what, n_points, n_elements) = match kind {
+        MeshKind::Tetrahedra => {
+            let m = super::input::tet_mesh(&a.input, a.common)?;
+            stage.set(format!("writing {}", a.output.display()));
+            biotet_io::write_tet_mesh(&a.output, &m)?;
+            ("tets", m.points.len(), m.tets.len())
+        }
+        MeshKind::Triangles2d => {
+            let m = biotet_io::read_tri_mesh(&a.input)?;
+            stage.set(format!("writing {}", a.output.display()));
+            biotet_io::write_tri_mesh(&a.output, &m)?;
+            ("triangles", m.points.len(), m.triangles.len())
+        }
+        MeshKind::Surface => {
+            // Conversion keeps the surface as it is (no validation), welded like any read.
+            let m = biotet_io::read_surface(&a.input)?.mesh;
+            stage.set(format!("writing {}", a.output.display()));
+            biotet_io::write_surface(&a.output, &m)?;
+            ("surface triangles", m.points.len(), m.triangles.len())
+        }
+    };
+    drop(stage);
+    if a.common.json {
+        let key = if what == "tets" {
+            "n_tets"
+        } else {
+            "n_triangles"
+        };
+        println!(
+            "{}",
+            json!({"input": a.input, "output": a.output, "n_points": n_points, key: n_elements})
+        );
+    } else if !a.common.quiet {
+        println!(
+            "{} -> {}: {n_points} points, {n_elements} {what}",
+            a.input.display(),
+            a.output.display()
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}

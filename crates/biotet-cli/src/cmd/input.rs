@@ -1,0 +1,45 @@
+//! Reading inputs with the CLI's messages: every error names the file.
+
+use crate::Common;
+use anyhow::{Context, Result};
+use biotet::mesh::validate::{ValidateOptions, ValidationReport, validate_surface};
+use biotet::{SurfaceMesh, TetMesh};
+use std::path::Path;
+
+/// Read a tet mesh, telling the user about tets that had to be reoriented.
+pub fn tet_mesh(path: &Path, common: Common) -> Result<TetMesh> {
+    let read = biotet_io::read_tet_mesh(path)?;
+    if read.flipped > 0 && !common.quiet && !common.json {
+        eprintln!(
+            "note: {}: {} negatively oriented tets were reoriented",
+            path.display(),
+            read.flipped
+        );
+    }
+    Ok(read.mesh)
+}
+
+/// Read and validate a closed surface. Refuses invalid surfaces with an error naming the file;
+/// flips an inward-oriented surface and says so.
+pub fn surface(path: &Path, common: Common) -> Result<(SurfaceMesh, ValidationReport)> {
+    let read = biotet_io::read_surface(path)?;
+    let mut mesh = read.mesh;
+    let report = validate_surface(&mut mesh, &ValidateOptions::default())
+        .with_context(|| format!("{}: invalid surface", path.display()))?;
+    if !common.quiet && !common.json {
+        if read.welded > 0 {
+            eprintln!(
+                "note: {}: welded {} duplicate vertices",
+                path.display(),
+                read.welded
+            );
+        }
+        if report.flipped_inward {
+            eprintln!(
+                "note: {}: the surface was oriented inward; all triangles were flipped",
+                path.display()
+            );
+        }
+    }
+    Ok((mesh, report))
+}

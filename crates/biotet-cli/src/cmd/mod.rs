@@ -1,0 +1,7 @@
+//! One module per subcommand, plus the shared input handling.
+
+pub mod check;
+pub mod convert;
+pub mod input;
+pub mod quality;
+pub mod validate;

@@ -1,0 +1,43 @@
+//! `biotet validate`: is a surface fit to be meshed?
+
+use crate::{Common, progress::Stage};
+use anyhow::Result;
+use serde_json::json;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Arguments of `biotet validate`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Surfaces: .stl .obj .off .ply .mesh.
+    #[arg(required = true)]
+    surfaces: Vec<PathBuf>,
+    #[command(flatten)]
+    common: Common,
+}
+
+/// Run `biotet validate`: exits 1 at the first invalid surface, naming it and the problem.
+pub fn run(a: Args) -> Result<ExitCode> {
+    let mut out = Vec::new();
+    for path in &a.surfaces {
+        let stage = Stage::start(a.common.quiet, format!("validating {}", path.display()));
+        let (mesh, report) = super::input::surface(path, a.common)?;
+        drop(stage);
+        if !a.common.quiet && !a.common.json {
+            println!(
+                "{}: valid: {} points, {} triangles\n{report}",
+                path.display(),
+                mesh.points.len(),
+                mesh.triangles.len()
+            );
+        }
+        out.push(json!({"file": path, "report": report}));
+    }
+    if a.common.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&json!({"surfaces": out}))?
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}

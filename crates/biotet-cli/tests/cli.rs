@@ -1,0 +1,322 @@
+//! The `biotet` binary end to end: real files in, exit codes, messages and outputs checked.
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn example() -> PathBuf {
+    root().join("examples/brain_tetgen.node")
+}
+
+fn brain_surface() -> PathBuf {
+    root().join("tests/data/brain_20k.stl")
+}
+
+fn biotet(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_biotet"))
+        .args(args)
+        .output()
+        .expect("the biotet binary runs")
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().expect("utf-8 path")
+}
+
+fn json_of(out: &Output) -> Value {
+    assert!(
+        out.status.success(),
+        "stderr: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("one JSON object on stdout")
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+#[test]
+fn help_everywhere() {
+    for cmd in [
+        vec!["--help"],
+        vec!["quality", "--help"],
+        vec!["check", "--help"],
+        vec!["convert", "--help"],
+        vec!["validate", "--help"],
+    ] {
+        let out = biotet(&cmd);
+        assert!(out.status.success(), "{cmd:?}");
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(text.contains("Usage"), "{cmd:?}: {text}");
+        if cmd.len() > 1 {
+            assert!(
+                text.contains("--quiet") && text.contains("--json"),
+                "{cmd:?}: {text}"
+            );
+        }
+    }
+}
+
+/// Every JSON key the README documents for `biotet quality --json`.
+const QUALITY_KEYS: &[&str] = &[
+    "n_points",
+    "n_tets",
+    "n_regions",
+    "volume",
+    "min_dihedral_deg",
+    "max_dihedral_deg",
+    "min_solid_angle_sr",
+    "mean_q",
+    "min_q",
+    "n_dihedral_lt_5",
+    "n_dihedral_lt_10",
+    "n_dihedral_lt_20",
+    "n_dihedral_gt_160",
+    "n_dihedral_gt_170",
+    "n_dihedral_gt_175",
+];
+
+#[test]
+fn quality_of_the_bundled_example() {
+    let dir = tempfile::tempdir().unwrap();
+    let svg = dir.path().join("q.svg");
+    let out = biotet(&["quality", s(&example()), "--json", "--svg", s(&svg)]);
+    let j = json_of(&out);
+    for k in QUALITY_KEYS {
+        assert!(j.get(k).is_some(), "missing key {k}");
+    }
+    // TetGen -pq1.4Y on brain_20k: 19,903 points and 95,654 tets (see examples/README.md).
+    assert_eq!(j["n_points"], 19903);
+    assert_eq!(j["n_tets"], 95654);
+    // The surface was kept (-Y), so the marching-cubes slivers remain: the worst dihedral angle
+    // is far below 1 degree while the bulk is fine.
+    let min_d = j["min_dihedral_deg"].as_f64().unwrap();
+    assert!(min_d > 0.0 && min_d < 1.0, "{min_d}");
+    assert!(j["mean_q"].as_f64().unwrap() > 0.5);
+    // The volume equals the surface's enclosed volume, 1,659,213 mm³ (tests/data/README.md).
+    let v = j["volume"].as_f64().unwrap();
+    assert!((v - 1_659_213.0).abs() < 1.0, "{v}");
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(
+        text.starts_with("<svg") || text.starts_with("<?xml"),
+        "{}",
+        &text[..100]
+    );
+    assert!(text.contains("</svg>"));
+}
+
+#[test]
+fn the_bundled_example_passes_the_checker_with_its_surface() {
+    let out = biotet(&[
+        "check",
+        s(&example()),
+        "--surface",
+        s(&brain_surface()),
+        "--json",
+    ]);
+    let j = json_of(&out);
+    assert_eq!(j["valid"], true);
+    assert_eq!(j["surface"]["n_triangles"], 19648);
+    assert_eq!(j["surface"]["n_found"], 19648);
+}
+
+#[test]
+fn convert_round_trips_through_every_tet_format_byte_identically() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut prev = example();
+    for ext in ["vtu", "mesh", "msh", "ele", "vtu"] {
+        let out_path = dir.path().join(format!("m_{ext}.{ext}"));
+        let out = biotet(&["convert", s(&prev), "-o", s(&out_path), "--quiet"]);
+        assert!(out.status.success(), "{ext}: {}", stderr(&out));
+        assert!(out.stdout.is_empty(), "--quiet prints nothing");
+        // Same input, same options: the same bytes.
+        let again = dir.path().join(format!("again.{ext}"));
+        let out = biotet(&["convert", s(&prev), "-o", s(&again), "--quiet"]);
+        assert!(out.status.success());
+        if ext != "ele" {
+            assert_eq!(
+                std::fs::read(&out_path).unwrap(),
+                std::fs::read(&again).unwrap()
+            );
+        }
+        let j = json_of(&biotet(&[
+            "check",
+            s(&out_path),
+            "--surface",
+            s(&brain_surface()),
+            "--json",
+        ]));
+        assert_eq!(j["valid"], true, "{ext}");
+        assert_eq!(j["n_tets"], 95654, "{ext}");
+        prev = out_path;
+    }
+}
+
+/// A unit cube as OFF text: 8 corners, 12 outward triangles; `edit` may change it.
+fn cube_off(edit: impl FnOnce(&mut Vec<[usize; 3]>, &mut Vec<[f64; 3]>)) -> String {
+    let mut pts: Vec<[f64; 3]> = (0..8)
+        .map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64])
+        .collect();
+    let mut tris = vec![
+        [0, 2, 3],
+        [0, 3, 1],
+        [4, 5, 7],
+        [4, 7, 6],
+        [0, 1, 5],
+        [0, 5, 4],
+        [2, 6, 7],
+        [2, 7, 3],
+        [0, 4, 6],
+        [0, 6, 2],
+        [1, 3, 7],
+        [1, 7, 5],
+    ];
+    edit(&mut tris, &mut pts);
+    let mut s = format!("OFF\n{} {} 0\n", pts.len(), tris.len());
+    for p in &pts {
+        s += &format!("{} {} {}\n", p[0], p[1], p[2]);
+    }
+    for t in &tris {
+        s += &format!("3 {} {} {}\n", t[0], t[1], t[2]);
+    }
+    s
+}
+
+fn validate_text(name: &str, text: &str) -> (Output, PathBuf, tempfile::TempDir) {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join(name);
+    std::fs::write(&p, text).unwrap();
+    (biotet(&["validate", s(&p)]), p, dir)
+}
+
+#[test]
+fn good_cube_validates() {
+    let (out, _, _d) = validate_text("cube.off", &cube_off(|_, _| {}));
+    assert!(out.status.success(), "{}", stderr(&out));
+}
+
+#[test]
+fn bad_surfaces_get_a_clear_error() {
+    let hole = cube_off(|t, _| {
+        t.pop();
+    });
+    let flipped = cube_off(|t, _| t[3].swap(1, 2));
+    // A second cube poking through the first one's face x = 1.
+    let crossing = cube_off(|t, p| {
+        let o = p.len();
+        for i in 0..8 {
+            let q = [
+                0.5 + (i & 1) as f64,
+                0.25 + 0.5 * ((i >> 1) & 1) as f64,
+                0.25 + 0.5 * ((i >> 2) & 1) as f64,
+            ];
+            p.push(q);
+        }
+        let first: Vec<[usize; 3]> = t.clone();
+        t.extend(first.iter().map(|f| f.map(|v| v + o)));
+    });
+    // A second cube sharing only the edge (1,1,z) of the first: a non-manifold edge.
+    let nonmanifold = cube_off(|t, p| {
+        let mut map = [0usize; 8];
+        for (i, slot) in map.iter_mut().enumerate() {
+            let q = [
+                1.0 + (i & 1) as f64,
+                1.0 + ((i >> 1) & 1) as f64,
+                ((i >> 2) & 1) as f64,
+            ];
+            *slot = match p.iter().position(|x| *x == q) {
+                Some(j) => j,
+                None => {
+                    p.push(q);
+                    p.len() - 1
+                }
+            };
+        }
+        let first: Vec<[usize; 3]> = t.clone();
+        t.extend(first.iter().map(|f| f.map(|v| map[v])));
+    });
+    for (name, text, words) in [
+        ("hole.off", hole, &["hole.off", "closed"][..]),
+        ("flipped.off", flipped, &["flipped.off", "orient"][..]),
+        ("crossing.off", crossing, &["crossing.off", "intersect"][..]),
+        (
+            "nonmanifold.off",
+            nonmanifold,
+            &["nonmanifold.off", "manifold"][..],
+        ),
+    ] {
+        let (out, _, _d) = validate_text(name, &text);
+        assert_eq!(out.status.code(), Some(1), "{name} must be refused");
+        let msg = stderr(&out);
+        for w in words {
+            assert!(
+                msg.to_lowercase().contains(&w.to_lowercase()),
+                "{name}: {msg}"
+            );
+        }
+        assert!(!msg.contains("panicked"), "{msg}");
+        // The message names a triangle with coordinates.
+        assert!(
+            msg.contains("triangle") && msg.contains('('),
+            "{name}: {msg}"
+        );
+    }
+}
+
+#[test]
+fn inward_surface_is_flipped_and_the_user_told() {
+    let inward = cube_off(|t, _| {
+        for f in t.iter_mut() {
+            f.swap(1, 2);
+        }
+    });
+    let (out, _, _d) = validate_text("inward.off", &inward);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("flipped"), "{}", stderr(&out));
+}
+
+#[test]
+fn missing_and_garbage_inputs_fail_cleanly_and_write_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_path = dir.path().join("out.vtu");
+    let missing = dir.path().join("nope.mesh");
+    let garbage = dir.path().join("garbage.msh");
+    std::fs::write(
+        &garbage,
+        "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 2 1",
+    )
+    .unwrap();
+    for input in [&missing, &garbage] {
+        let out = biotet(&["convert", s(input), "-o", s(&out_path)]);
+        assert_eq!(out.status.code(), Some(1));
+        let msg = stderr(&out);
+        assert!(msg.starts_with("error: "), "{msg}");
+        assert!(
+            msg.contains(input.file_name().unwrap().to_str().unwrap()),
+            "{msg}"
+        );
+        assert!(!msg.contains("panicked"), "{msg}");
+        assert!(!out_path.exists());
+    }
+    // Nothing but the input is left in the folder: no temporary files either.
+    let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert_eq!(names.len(), 1);
+}
+
+#[test]
+fn check_fails_when_a_surface_triangle_is_missing() {
+    // The example checked against the white-matter surface, which it does not contain.
+    let out = biotet(&[
+        "check",
+        s(&example()),
+        "--surface",
+        s(&root().join("tests/data/wm_20k.stl")),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("INVALID"));
+}

@@ -1,0 +1,227 @@
+//! Helpers shared by several formats: orientation repair, writer-side validation and the
+//! boundary/interface face groups written by the tet writers.
+
+use std::io::Read;
+
+use biotet::geom::predicates::{Sign, orient2d, orient3d};
+use biotet::mesh::tet::face_adjacency;
+use biotet::{NO_NEIGHBOR, SurfaceMesh, TetMesh, TriMesh};
+
+use crate::error::{Error, Result};
+
+/// Read a whole stream into memory.
+pub(crate) fn read_all<R: Read>(mut r: R, file: &str) -> Result<Vec<u8>> {
+    let mut data = Vec::new();
+    r.read_to_end(&mut data).map_err(|e| Error::io(file, e))?;
+    Ok(data)
+}
+
+/// Make every tet positively oriented by swapping its last two vertices when `orient3d` says
+/// it is negative. Returns `(flipped, degenerate)`; degenerate (zero-volume) tets are kept.
+/// Indices must be in range.
+pub(crate) fn orient_tets(points: &[[f64; 3]], tets: &mut [[u32; 4]]) -> (usize, usize) {
+    let (mut flipped, mut degenerate) = (0, 0);
+    for t in tets.iter_mut() {
+        let p = |i: usize| points[t[i] as usize];
+        match orient3d(p(0), p(1), p(2), p(3)) {
+            Sign::Negative => {
+                t.swap(2, 3);
+                flipped += 1;
+            }
+            Sign::Zero => degenerate += 1,
+            Sign::Positive => {}
+        }
+    }
+    (flipped, degenerate)
+}
+
+/// Make every triangle counter-clockwise; returns `(flipped, degenerate)`.
+pub(crate) fn orient_tris(points: &[[f64; 2]], tris: &mut [[u32; 3]]) -> (usize, usize) {
+    let (mut flipped, mut degenerate) = (0, 0);
+    for t in tris.iter_mut() {
+        let p = |i: usize| points[t[i] as usize];
+        match orient2d(p(0), p(1), p(2)) {
+            Sign::Negative => {
+                t.swap(1, 2);
+                flipped += 1;
+            }
+            Sign::Zero => degenerate += 1,
+            Sign::Positive => {}
+        }
+    }
+    (flipped, degenerate)
+}
+
+/// A label from an integer read from a file.
+pub(crate) fn label_of(v: i64) -> std::result::Result<u32, String> {
+    u32::try_from(v).map_err(|_| format!("region label {v} is not in 0..={}", u32::MAX))
+}
+
+/// A label from a float attribute (TetGen writes attributes as reals).
+pub(crate) fn label_of_f64(v: f64) -> std::result::Result<u32, String> {
+    if v.fract() == 0.0 && (0.0..=u32::MAX as f64).contains(&v) {
+        Ok(v as u32)
+    } else {
+        Err(format!(
+            "region attribute {v} is not an integer in 0..={}",
+            u32::MAX
+        ))
+    }
+}
+
+/// Number of points as `u32`, or an error.
+pub(crate) fn check_point_count(n: usize, file: &str) -> Result<()> {
+    if n > u32::MAX as usize {
+        return Err(Error::format(
+            file,
+            format!("{n} points do not fit 32-bit indices"),
+        ));
+    }
+    Ok(())
+}
+
+fn check_points<const D: usize>(points: &[[f64; D]], file: &str) -> Result<()> {
+    check_point_count(points.len(), file)?;
+    for (i, p) in points.iter().enumerate() {
+        if p.iter().any(|c| !c.is_finite()) {
+            return Err(Error::invalid(
+                file,
+                format!("point {i} has a non-finite coordinate {p:?}"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn check_cells<const K: usize>(cells: &[[u32; K]], n: usize, what: &str, file: &str) -> Result<()> {
+    for (i, c) in cells.iter().enumerate() {
+        if let Some(v) = c.iter().find(|&&v| v as usize >= n) {
+            return Err(Error::invalid(
+                file,
+                format!("{what} {i}: vertex index {v} out of range ({n} points)"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Validate a surface before writing it.
+pub(crate) fn check_surface(m: &SurfaceMesh, file: &str) -> Result<()> {
+    check_points(&m.points, file)?;
+    check_cells(&m.triangles, m.points.len(), "triangle", file)
+}
+
+/// Validate a tet mesh before writing it.
+pub(crate) fn check_tet(m: &TetMesh, file: &str) -> Result<()> {
+    if m.labels.len() != m.tets.len() {
+        return Err(Error::invalid(
+            file,
+            format!("{} labels for {} tets", m.labels.len(), m.tets.len()),
+        ));
+    }
+    check_points(&m.points, file)?;
+    check_cells(&m.tets, m.points.len(), "tet", file)
+}
+
+/// Validate a triangle mesh before writing it.
+pub(crate) fn check_tri(m: &TriMesh, file: &str) -> Result<()> {
+    if m.labels.len() != m.triangles.len() {
+        return Err(Error::invalid(
+            file,
+            format!(
+                "{} labels for {} triangles",
+                m.labels.len(),
+                m.triangles.len()
+            ),
+        ));
+    }
+    check_points(&m.points, file)?;
+    check_cells(&m.triangles, m.points.len(), "triangle", file)
+}
+
+/// One group of surface faces of a tet mesh: the outer boundary of a region, or the interface
+/// between two regions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub(crate) struct FaceGroup {
+    /// `false`: faces between region `a` and the outside (`b` = 0). `true`: faces between
+    /// regions `a < b`.
+    pub interface: bool,
+    /// The region whose tets own the faces (faces are oriented outward from it).
+    pub a: u32,
+    /// The region on the other side (0 for the outside).
+    pub b: u32,
+}
+
+impl FaceGroup {
+    /// "boundary_a_0" or "interface_a_b".
+    pub fn name(&self) -> String {
+        if self.interface {
+            format!("interface_{}_{}", self.a, self.b)
+        } else {
+            format!("boundary_{}_0", self.a)
+        }
+    }
+}
+
+/// Boundary and interface faces of a tet mesh, grouped.
+pub(crate) struct FaceGroups {
+    /// The groups, sorted: boundaries by region, then interfaces by region pair. A face's marker
+    /// or ref in the Medit/Gmsh/TetGen writers is its group index + 1.
+    pub groups: Vec<FaceGroup>,
+    /// Faces (outward from the owning region), sorted by group, in tet order within a group.
+    pub faces: Vec<[u32; 3]>,
+    /// Group index of each face.
+    pub group_of: Vec<u32>,
+}
+
+/// Collect the faces with no tet behind them and the faces between tets of different labels
+/// (each once, oriented outward from the smaller label).
+pub(crate) fn face_groups(m: &TetMesh) -> FaceGroups {
+    let recomputed;
+    let nb: &[[u32; 4]] = if m.neighbors.len() == m.tets.len() {
+        &m.neighbors
+    } else {
+        recomputed = face_adjacency(&m.tets).0;
+        &recomputed
+    };
+    let mut raw: Vec<(FaceGroup, u32)> = Vec::new();
+    for (t, n) in nb.iter().enumerate() {
+        let a = m.labels[t];
+        for (f, &o) in n.iter().enumerate() {
+            let g = if o == NO_NEIGHBOR {
+                FaceGroup {
+                    interface: false,
+                    a,
+                    b: 0,
+                }
+            } else {
+                let b = m.labels[o as usize];
+                if a >= b {
+                    continue;
+                }
+                FaceGroup {
+                    interface: true,
+                    a,
+                    b,
+                }
+            };
+            raw.push((g, (t as u32) << 2 | f as u32));
+        }
+    }
+    raw.sort_unstable();
+    let mut groups: Vec<FaceGroup> = Vec::new();
+    let mut faces = Vec::with_capacity(raw.len());
+    let mut group_of = Vec::with_capacity(raw.len());
+    for (g, tf) in raw {
+        if groups.last() != Some(&g) {
+            groups.push(g);
+        }
+        faces.push(m.face((tf >> 2) as usize, (tf & 3) as usize));
+        group_of.push(groups.len() as u32 - 1);
+    }
+    FaceGroups {
+        groups,
+        faces,
+        group_of,
+    }
+}

@@ -1,0 +1,1139 @@
+//! VTK XML unstructured grid (`.vtu`): tet meshes.
+//!
+//! Writing: by default ([`VtuEncoding::Raw`]) all arrays go, uncompressed, into one
+//! `<AppendedData encoding="raw">` block with `UInt64` byte-count headers — the fastest to write
+//! and read, and what ParaView itself writes with compression off. Also available: zlib-compressed
+//! appended data, inline base64 (optionally compressed) and ASCII. Points are `Float64` (exact),
+//! connectivity and offsets `Int32` (`Int64` when needed), cell types `UInt8` (10 = tetra).
+//! Cell data: `region` (`Int32`, the label; marked as the active scalars), and per tet, from
+//! [`TetMeasures`]: `min_dihedral_deg`, `min_solid_angle_sr` and `q` (`Float64`).
+//!
+//! Reading: `UnstructuredGrid` files with any number of pieces; data arrays in `ascii`, inline
+//! `binary` (base64) or `appended` (`raw` or `base64`) format, optionally compressed with
+//! `vtkZLibDataCompressor`, `UInt32` or `UInt64` headers, either byte order, any numeric type.
+//! Only linear tetrahedra (cell type 10) are read; other volume cells (hexahedra, wedges,
+//! pyramids, voxels, quadratic or higher-order cells, polyhedra) are counted in
+//! [`TetRead::skipped_elements`], and vertices, lines and surface cells are ignored silently.
+//! The label comes from the first cell-data array named `region`, `gmsh:physical`,
+//! `medit:ref`, `CellEntityIds`, `tetgen:ref`, `label`, `labels`, `material` or `MaterialIds`,
+//! else from the first single-component integer cell-data array, else it is 1; labels must be
+//! non-negative integers. LZ4 and LZMA compression are rejected with a clear error.
+
+use std::io::{Read, Write};
+
+use biotet::TetMesh;
+use biotet::quality::tet::TetMeasures;
+
+use crate::TetRead;
+use crate::b64;
+use crate::common::{check_tet, orient_tets, read_all};
+use crate::error::{Error, Result};
+use crate::text::{Out, parse_f64, parse_i64, show};
+
+/// How [`write_tet_with`] encodes the data arrays.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum VtuEncoding {
+    /// Appended raw binary (the default; fastest).
+    #[default]
+    Raw,
+    /// Appended raw binary, zlib-compressed (smaller, slower).
+    RawZlib,
+    /// Inline base64 binary.
+    Base64,
+    /// Inline base64 binary, zlib-compressed.
+    Base64Zlib,
+    /// Inline ASCII.
+    Ascii,
+}
+
+/// Array values to write.
+enum Data {
+    F64(Vec<f64>),
+    I32(Vec<i32>),
+    I64(Vec<i64>),
+    U8(Vec<u8>),
+}
+
+impl Data {
+    fn ty(&self) -> &'static str {
+        match self {
+            Data::F64(_) => "Float64",
+            Data::I32(_) => "Int32",
+            Data::I64(_) => "Int64",
+            Data::U8(_) => "UInt8",
+        }
+    }
+
+    fn bytes(&self) -> Vec<u8> {
+        match self {
+            Data::F64(v) => v.iter().flat_map(|x| x.to_le_bytes()).collect(),
+            Data::I32(v) => v.iter().flat_map(|x| x.to_le_bytes()).collect(),
+            Data::I64(v) => v.iter().flat_map(|x| x.to_le_bytes()).collect(),
+            Data::U8(v) => v.clone(),
+        }
+    }
+}
+
+struct Array {
+    name: &'static str,
+    ncomp: usize,
+    data: Data,
+}
+
+/// Per-tet quality: (min dihedral degrees, min solid angle steradians, q), computed on all cores.
+fn quality(mesh: &TetMesh) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let n = mesh.tets.len();
+    let mut dih = vec![0.0; n];
+    let mut sol = vec![0.0; n];
+    let mut q = vec![0.0; n];
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |t| t.get())
+        .min(16);
+    let chunk = n.div_ceil(threads).max(4096);
+    std::thread::scope(|s| {
+        for (k, ((d, so), qq)) in dih
+            .chunks_mut(chunk)
+            .zip(sol.chunks_mut(chunk))
+            .zip(q.chunks_mut(chunk))
+            .enumerate()
+        {
+            s.spawn(move || {
+                for i in 0..d.len() {
+                    let m = TetMeasures::of(&mesh.corners(k * chunk + i));
+                    d[i] = m.min_dihedral();
+                    so[i] = m.min_solid();
+                    qq[i] = m.q;
+                }
+            });
+        }
+    });
+    (dih, sol, q)
+}
+
+fn arrays(mesh: &TetMesh, file: &str) -> Result<(Vec<Array>, usize)> {
+    let nt = mesh.tets.len();
+    let wide_conn = mesh.points.len() > i32::MAX as usize;
+    let wide_off = 4 * nt > i32::MAX as usize;
+    let conn = if wide_conn {
+        Data::I64(mesh.tets.iter().flatten().map(|&v| v as i64).collect())
+    } else {
+        Data::I32(mesh.tets.iter().flatten().map(|&v| v as i32).collect())
+    };
+    let offsets = if wide_off {
+        Data::I64((1..=nt as i64).map(|i| 4 * i).collect())
+    } else {
+        Data::I32((1..=nt as i32).map(|i| 4 * i).collect())
+    };
+    let mut region = Vec::with_capacity(nt);
+    for (t, &l) in mesh.labels.iter().enumerate() {
+        region.push(
+            i32::try_from(l).map_err(|_| {
+                Error::invalid(file, format!("tet {t}: label {l} does not fit Int32"))
+            })?,
+        );
+    }
+    let (dih, sol, q) = quality(mesh);
+    let a = |name, ncomp, data| Array { name, ncomp, data };
+    Ok((
+        vec![
+            a("Points", 3, Data::F64(mesh.points.as_flattened().to_vec())),
+            a("connectivity", 1, conn),
+            a("offsets", 1, offsets),
+            a("types", 1, Data::U8(vec![10; nt])),
+            a("region", 1, Data::I32(region)),
+            a("min_dihedral_deg", 1, Data::F64(dih)),
+            a("min_solid_angle_sr", 1, Data::F64(sol)),
+            a("q", 1, Data::F64(q)),
+        ],
+        4,
+    ))
+}
+
+const ZBLOCK: usize = 1 << 16;
+
+/// The header and payload of one binary array: uncompressed `[nbytes]` + data, or VTK's zlib
+/// layout `[nblocks, blocksize, lastsize, csize...]` + compressed blocks.
+fn block(bytes: &[u8], zlib: bool, file: &str) -> Result<(Vec<u8>, Vec<u8>)> {
+    if !zlib {
+        return Ok(((bytes.len() as u64).to_le_bytes().to_vec(), bytes.to_vec()));
+    }
+    let mut header = Vec::new();
+    let mut payload = Vec::new();
+    let nblocks = bytes.len().div_ceil(ZBLOCK);
+    let last = bytes.len() % ZBLOCK;
+    for x in [nblocks as u64, ZBLOCK as u64, last as u64] {
+        header.extend_from_slice(&x.to_le_bytes());
+    }
+    for c in bytes.chunks(ZBLOCK) {
+        let mut e = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::fast());
+        e.write_all(c).map_err(|e| Error::io(file, e))?;
+        let z = e.finish().map_err(|e| Error::io(file, e))?;
+        header.extend_from_slice(&(z.len() as u64).to_le_bytes());
+        payload.extend_from_slice(&z);
+    }
+    Ok((header, payload))
+}
+
+/// Write a tet mesh as VTU with appended raw binary data.
+pub fn write_tet<W: Write>(w: W, mesh: &TetMesh, file: &str) -> Result<()> {
+    write_tet_with(w, mesh, file, VtuEncoding::Raw)
+}
+
+/// Write a tet mesh as VTU with the chosen encoding.
+pub fn write_tet_with<W: Write>(w: W, mesh: &TetMesh, file: &str, enc: VtuEncoding) -> Result<()> {
+    check_tet(mesh, file)?;
+    let (arrays, first_cell_array) = arrays(mesh, file)?;
+    let zlib = matches!(enc, VtuEncoding::RawZlib | VtuEncoding::Base64Zlib);
+    let io = |e| Error::io(file, e);
+    let mut out = Out::new(w);
+    out.s("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\"");
+    if zlib {
+        out.s(" compressor=\"vtkZLibDataCompressor\"");
+    }
+    out.s(">\n  <UnstructuredGrid>\n    <Piece NumberOfPoints=\"");
+    out.int(mesh.points.len());
+    out.s("\" NumberOfCells=\"");
+    out.int(mesh.tets.len());
+    out.s("\">\n");
+    // Appended blocks, computed up front for their offsets.
+    let appended = matches!(enc, VtuEncoding::Raw | VtuEncoding::RawZlib);
+    let mut blocks = Vec::new();
+    let mut offset = 0usize;
+    for (k, a) in arrays.iter().enumerate() {
+        match k {
+            0 => out.s("      <Points>\n"),
+            1 => out.s("      <Cells>\n"),
+            _ if k == first_cell_array => out.s("      <CellData Scalars=\"region\">\n"),
+            _ => {}
+        }
+        out.s("        <DataArray type=\"");
+        out.s(a.data.ty());
+        out.s("\" Name=\"");
+        out.s(a.name);
+        out.s("\"");
+        if a.ncomp != 1 {
+            out.s(" NumberOfComponents=\"");
+            out.int(a.ncomp);
+            out.s("\"");
+        }
+        match enc {
+            VtuEncoding::Raw | VtuEncoding::RawZlib => {
+                let (h, p) = block(&a.data.bytes(), zlib, file)?;
+                out.s(" format=\"appended\" offset=\"");
+                out.int(offset);
+                out.s("\"/>\n");
+                offset += h.len() + p.len();
+                blocks.push((h, p));
+            }
+            VtuEncoding::Base64 | VtuEncoding::Base64Zlib => {
+                out.s(" format=\"binary\">\n");
+                let (h, p) = block(&a.data.bytes(), zlib, file)?;
+                if zlib {
+                    b64::encode(&h, &mut out.buf);
+                    b64::encode(&p, &mut out.buf);
+                } else {
+                    let mut all = h;
+                    all.extend_from_slice(&p);
+                    b64::encode(&all, &mut out.buf);
+                }
+                out.s("\n        </DataArray>\n");
+            }
+            VtuEncoding::Ascii => {
+                out.s(" format=\"ascii\">\n");
+                macro_rules! nums {
+                    ($v:expr, $f:ident) => {
+                        for (i, x) in $v.iter().enumerate() {
+                            out.$f(*x);
+                            out.c(if i % 12 == 11 { b'\n' } else { b' ' });
+                            out.check().map_err(io)?;
+                        }
+                    };
+                }
+                match &a.data {
+                    Data::F64(v) => nums!(v, f64),
+                    Data::I32(v) => nums!(v, int),
+                    Data::I64(v) => nums!(v, int),
+                    Data::U8(v) => nums!(v, int),
+                }
+                out.s("\n        </DataArray>\n");
+            }
+        }
+        out.check().map_err(io)?;
+        match k {
+            0 => out.s("      </Points>\n"),
+            3 => out.s("      </Cells>\n"),
+            _ => {}
+        }
+    }
+    out.s("      </CellData>\n    </Piece>\n  </UnstructuredGrid>\n");
+    if appended {
+        out.s("  <AppendedData encoding=\"raw\">\n   _");
+        for (h, p) in &blocks {
+            out.bytes(h);
+            out.check().map_err(io)?;
+            for c in p.chunks(1 << 16) {
+                out.bytes(c);
+                out.check().map_err(io)?;
+            }
+        }
+        out.s("\n  </AppendedData>\n");
+    }
+    out.s("</VTKFile>\n");
+    out.finish().map_err(io)?;
+    Ok(())
+}
+
+// ---------------------------------------------------------------------------------------------
+// Reading.
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Ty {
+    I8,
+    U8,
+    I16,
+    U16,
+    I32,
+    U32,
+    I64,
+    U64,
+    F32,
+    F64,
+}
+
+impl Ty {
+    fn parse(s: &[u8]) -> Option<Ty> {
+        Some(match s {
+            b"Int8" | b"Char" => Ty::I8,
+            b"UInt8" | b"UChar" => Ty::U8,
+            b"Int16" => Ty::I16,
+            b"UInt16" => Ty::U16,
+            b"Int32" => Ty::I32,
+            b"UInt32" => Ty::U32,
+            b"Int64" => Ty::I64,
+            b"UInt64" => Ty::U64,
+            b"Float32" => Ty::F32,
+            b"Float64" => Ty::F64,
+            _ => return None,
+        })
+    }
+
+    fn size(self) -> usize {
+        match self {
+            Ty::I8 | Ty::U8 => 1,
+            Ty::I16 | Ty::U16 => 2,
+            Ty::I32 | Ty::U32 | Ty::F32 => 4,
+            Ty::I64 | Ty::U64 | Ty::F64 => 8,
+        }
+    }
+
+    fn is_float(self) -> bool {
+        matches!(self, Ty::F32 | Ty::F64)
+    }
+}
+
+enum Values {
+    F(Vec<f64>),
+    I(Vec<i64>),
+}
+
+impl Values {
+    fn len(&self) -> usize {
+        match self {
+            Values::F(v) => v.len(),
+            Values::I(v) => v.len(),
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Format {
+    Ascii,
+    Binary,
+    Appended,
+}
+
+#[derive(Debug)]
+struct ArrayRef<'a> {
+    name: &'a [u8],
+    ty: Ty,
+    ncomp: usize,
+    format: Format,
+    offset: usize,
+    /// Inline content (ascii or base64).
+    content: &'a [u8],
+    /// Byte position of the tag (for line numbers in errors).
+    at: usize,
+}
+
+#[derive(Debug, Default)]
+struct Piece<'a> {
+    npts: usize,
+    ncells: usize,
+    points: Option<ArrayRef<'a>>,
+    conn: Option<ArrayRef<'a>>,
+    offsets: Option<ArrayRef<'a>>,
+    types: Option<ArrayRef<'a>>,
+    cell_data: Vec<ArrayRef<'a>>,
+}
+
+struct Ctx<'a> {
+    data: &'a [u8],
+    file: &'a str,
+    be: bool,
+    header64: bool,
+    zlib: bool,
+    /// Start of appended data (after `_`), and whether it is base64.
+    app: Option<(usize, bool)>,
+    app_end: usize,
+    /// Sorted offsets of all appended arrays (to delimit base64 appended arrays).
+    app_offsets: Vec<usize>,
+}
+
+fn find(hay: &[u8], from: usize, needle: &[u8]) -> Option<usize> {
+    if from > hay.len() {
+        return None;
+    }
+    let first = needle[0];
+    let mut i = from;
+    while i + needle.len() <= hay.len() {
+        match hay[i..].iter().position(|&c| c == first) {
+            Some(k) => {
+                i += k;
+                if i + needle.len() <= hay.len() && &hay[i..i + needle.len()] == needle {
+                    return Some(i);
+                }
+                i += 1;
+            }
+            None => return None,
+        }
+    }
+    None
+}
+
+struct Tag<'a> {
+    name: &'a [u8],
+    attrs: Vec<(&'a [u8], &'a [u8])>,
+    closing: bool,
+    self_closing: bool,
+    start: usize,
+    end: usize,
+}
+
+impl<'a> Tag<'a> {
+    fn attr(&self, k: &str) -> Option<&'a [u8]> {
+        self.attrs
+            .iter()
+            .find(|(n, _)| *n == k.as_bytes())
+            .map(|(_, v)| *v)
+    }
+}
+
+impl<'a> Ctx<'a> {
+    fn line_at(&self, pos: usize) -> usize {
+        1 + self.data[..pos.min(self.data.len())]
+            .iter()
+            .filter(|&&c| c == b'\n')
+            .count()
+    }
+
+    fn err_at(&self, pos: usize, msg: impl Into<String>) -> Error {
+        Error::line(self.file, self.line_at(pos), msg)
+    }
+
+    /// The next tag in `xml` from `*pos`, skipping declarations and comments.
+    fn next_tag(&self, xml: &'a [u8], pos: &mut usize) -> Result<Option<Tag<'a>>> {
+        loop {
+            let Some(lt) = find(xml, *pos, b"<") else {
+                return Ok(None);
+            };
+            let rest = &xml[lt..];
+            if rest.starts_with(b"<!--") {
+                *pos = find(xml, lt, b"-->")
+                    .ok_or_else(|| self.err_at(lt, "unterminated XML comment"))?
+                    + 3;
+                continue;
+            }
+            if rest.starts_with(b"<?") || rest.starts_with(b"<!") {
+                *pos = find(xml, lt, b">")
+                    .ok_or_else(|| self.err_at(lt, "unterminated XML declaration"))?
+                    + 1;
+                continue;
+            }
+            let mut i = lt + 1;
+            let closing = xml.get(i) == Some(&b'/');
+            if closing {
+                i += 1;
+            }
+            let ns = i;
+            while i < xml.len() && !xml[i].is_ascii_whitespace() && xml[i] != b'>' && xml[i] != b'/'
+            {
+                i += 1;
+            }
+            let name = &xml[ns..i];
+            let mut attrs = Vec::new();
+            loop {
+                while i < xml.len() && xml[i].is_ascii_whitespace() {
+                    i += 1;
+                }
+                match xml.get(i) {
+                    None => return Err(self.err_at(lt, "unterminated XML tag")),
+                    Some(b'>') => {
+                        *pos = i + 1;
+                        return Ok(Some(Tag {
+                            name,
+                            attrs,
+                            closing,
+                            self_closing: false,
+                            start: lt,
+                            end: i + 1,
+                        }));
+                    }
+                    Some(b'/') if xml.get(i + 1) == Some(&b'>') => {
+                        *pos = i + 2;
+                        return Ok(Some(Tag {
+                            name,
+                            attrs,
+                            closing,
+                            self_closing: true,
+                            start: lt,
+                            end: i + 2,
+                        }));
+                    }
+                    _ => {}
+                }
+                let ks = i;
+                while i < xml.len()
+                    && xml[i] != b'='
+                    && !xml[i].is_ascii_whitespace()
+                    && xml[i] != b'>'
+                {
+                    i += 1;
+                }
+                let key = &xml[ks..i];
+                while i < xml.len() && xml[i].is_ascii_whitespace() {
+                    i += 1;
+                }
+                if xml.get(i) != Some(&b'=') {
+                    return Err(self.err_at(lt, format!("malformed XML attribute '{}'", show(key))));
+                }
+                i += 1;
+                while i < xml.len() && xml[i].is_ascii_whitespace() {
+                    i += 1;
+                }
+                let q = match xml.get(i) {
+                    Some(&q @ (b'"' | b'\'')) => q,
+                    _ => {
+                        return Err(
+                            self.err_at(lt, format!("unquoted XML attribute '{}'", show(key)))
+                        );
+                    }
+                };
+                let vs = i + 1;
+                let ve = xml[vs..]
+                    .iter()
+                    .position(|&c| c == q)
+                    .map(|k| vs + k)
+                    .ok_or_else(|| self.err_at(lt, "unterminated XML attribute value"))?;
+                attrs.push((key, &xml[vs..ve]));
+                i = ve + 1;
+            }
+        }
+    }
+
+    fn header_int(&self, b: &[u8]) -> u64 {
+        let mut x = [0u8; 8];
+        let n = if self.header64 { 8 } else { 4 };
+        x[..n].copy_from_slice(&b[..n]);
+        if self.be {
+            x[..n].reverse();
+        }
+        u64::from_le_bytes(x)
+    }
+
+    /// Decode a binary block (header + data) starting at `bytes[0]`. `max` bounds the decoded
+    /// size; `name` names the array in errors.
+    fn unblock(&self, bytes: &[u8], name: &str, max: usize) -> Result<Vec<u8>> {
+        let hs = if self.header64 { 8 } else { 4 };
+        let trunc = || Error::truncated(self.file, format!("data of array '{name}' is incomplete"));
+        if bytes.len() < hs {
+            return Err(trunc());
+        }
+        if !self.zlib {
+            let n = self.header_int(bytes);
+            if n > (bytes.len() - hs) as u64 {
+                return Err(trunc());
+            }
+            return Ok(bytes[hs..hs + n as usize].to_vec());
+        }
+        if bytes.len() < 3 * hs {
+            return Err(trunc());
+        }
+        let nb = self.header_int(bytes);
+        let bs = self.header_int(&bytes[hs..]);
+        let last = self.header_int(&bytes[2 * hs..]);
+        if nb > ((bytes.len() - 3 * hs) / hs) as u64 {
+            return Err(trunc());
+        }
+        let nb = nb as usize;
+        let total = if nb == 0 {
+            0
+        } else {
+            (nb as u64 - 1)
+                .saturating_mul(bs)
+                .saturating_add(if last == 0 { bs } else { last })
+        };
+        // zlib expands at most ~1032:1, so more than that is a lie (and must not be allocated).
+        if total > max as u64 || total > (bytes.len() as u64).saturating_mul(1100) {
+            return Err(Error::format(
+                self.file,
+                format!(
+                    "array '{name}': compressed header announces {total} bytes, more than the {max} expected"
+                ),
+            ));
+        }
+        let mut out = Vec::with_capacity(total as usize);
+        let mut pos = 3 * hs + nb * hs;
+        for k in 0..nb {
+            let cs = self.header_int(&bytes[3 * hs + k * hs..]);
+            if cs > (bytes.len() - pos) as u64 {
+                return Err(trunc());
+            }
+            let want = if k + 1 == nb && last != 0 { last } else { bs };
+            let before = out.len();
+            let mut dec = flate2::read::ZlibDecoder::new(&bytes[pos..pos + cs as usize]).take(want);
+            dec.read_to_end(&mut out).map_err(|e| {
+                Error::format(self.file, format!("array '{name}': zlib block {k}: {e}"))
+            })?;
+            if (out.len() - before) as u64 != want {
+                return Err(Error::format(
+                    self.file,
+                    format!(
+                        "array '{name}': zlib block {k} decompresses to {} bytes, expected {want}",
+                        out.len() - before
+                    ),
+                ));
+            }
+            pos += cs as usize;
+        }
+        Ok(out)
+    }
+
+    /// The values of an array: `count` of them (components included) when given, else all.
+    fn values(&self, a: &ArrayRef, count: Option<usize>) -> Result<Values> {
+        let name = String::from_utf8_lossy(a.name).into_owned();
+        let size = a.ty.size();
+        // Bound for decoded sizes: what the file could plausibly hold.
+        let max = match count {
+            Some(c) => c.saturating_mul(size),
+            None => self.data.len().saturating_mul(1100),
+        };
+        let bytes = match a.format {
+            Format::Ascii => return self.ascii(a, &name, count),
+            Format::Binary => {
+                let raw = b64::decode(a.content).ok_or_else(|| {
+                    self.err_at(a.at, format!("array '{name}': invalid base64 data"))
+                })?;
+                self.unblock(&raw, &name, max)?
+            }
+            Format::Appended => {
+                let (start, base64) = self.app.ok_or_else(|| {
+                    self.err_at(
+                        a.at,
+                        format!("array '{name}' is appended but there is no AppendedData"),
+                    )
+                })?;
+                let s = start.saturating_add(a.offset);
+                if s > self.data.len() {
+                    return Err(Error::truncated(
+                        self.file,
+                        format!("appended data of array '{name}' is missing"),
+                    ));
+                }
+                if base64 {
+                    let end = self
+                        .app_offsets
+                        .iter()
+                        .find(|&&o| o > a.offset)
+                        .map_or(self.app_end, |&o| (start + o).min(self.app_end));
+                    let raw = b64::decode(&self.data[s..end.max(s)]).ok_or_else(|| {
+                        self.err_at(a.at, format!("array '{name}': invalid base64 data"))
+                    })?;
+                    self.unblock(&raw, &name, max)?
+                } else {
+                    self.unblock(&self.data[s..], &name, max)?
+                }
+            }
+        };
+        let n = bytes.len() / size;
+        let n = match count {
+            Some(c) if c > n => {
+                return Err(Error::truncated(
+                    self.file,
+                    format!("array '{name}' has {n} values, expected {c}"),
+                ));
+            }
+            Some(c) => c,
+            None => n,
+        };
+        let mut x = [0u8; 8];
+        let mut get = |i: usize| -> [u8; 8] {
+            x = [0; 8];
+            x[..size].copy_from_slice(&bytes[i * size..(i + 1) * size]);
+            if self.be {
+                x[..size].reverse();
+            }
+            x
+        };
+        Ok(match a.ty {
+            Ty::F32 => Values::F(
+                (0..n)
+                    .map(|i| {
+                        let b = get(i);
+                        f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64
+                    })
+                    .collect(),
+            ),
+            Ty::F64 => Values::F((0..n).map(|i| f64::from_le_bytes(get(i))).collect()),
+            ty => Values::I(
+                (0..n)
+                    .map(|i| {
+                        let b = get(i);
+                        match ty {
+                            Ty::I8 => b[0] as i8 as i64,
+                            Ty::U8 => b[0] as i64,
+                            Ty::I16 => i16::from_le_bytes([b[0], b[1]]) as i64,
+                            Ty::U16 => u16::from_le_bytes([b[0], b[1]]) as i64,
+                            Ty::I32 => i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as i64,
+                            Ty::U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as i64,
+                            Ty::I64 => i64::from_le_bytes(b),
+                            // Values above i64::MAX become negative and are rejected as indices.
+                            _ => u64::from_le_bytes(b) as i64,
+                        }
+                    })
+                    .collect(),
+            ),
+        })
+    }
+
+    fn ascii(&self, a: &ArrayRef, name: &str, count: Option<usize>) -> Result<Values> {
+        let toks = a
+            .content
+            .split(|c| c.is_ascii_whitespace())
+            .filter(|t| !t.is_empty());
+        let toks = toks.take(count.unwrap_or(usize::MAX));
+        let bad = |t: &[u8]| self.err_at(a.at, format!("array '{name}': bad number '{}'", show(t)));
+        let v = if a.ty.is_float() {
+            let mut v = Vec::new();
+            for t in toks {
+                v.push(parse_f64(t).ok_or_else(|| bad(t))?);
+            }
+            Values::F(v)
+        } else {
+            let mut v = Vec::new();
+            for t in toks {
+                v.push(parse_i64(t).ok_or_else(|| bad(t))?);
+            }
+            Values::I(v)
+        };
+        if let Some(c) = count
+            && v.len() < c
+        {
+            return Err(Error::truncated(
+                self.file,
+                format!("array '{name}' has {} values, expected {c}", v.len()),
+            ));
+        }
+        Ok(v)
+    }
+
+    fn ints(&self, a: &ArrayRef, count: Option<usize>) -> Result<Vec<i64>> {
+        match self.values(a, count)? {
+            Values::I(v) => Ok(v),
+            Values::F(v) => {
+                let mut out = Vec::with_capacity(v.len());
+                for (i, x) in v.into_iter().enumerate() {
+                    if x.fract() != 0.0 || !(i64::MIN as f64..=i64::MAX as f64).contains(&x) {
+                        return Err(Error::element(
+                            self.file,
+                            "value",
+                            i,
+                            format!("array '{}': {x} is not an integer", show(a.name)),
+                        ));
+                    }
+                    out.push(x as i64);
+                }
+                Ok(out)
+            }
+        }
+    }
+}
+
+/// Read a VTU tet mesh from a stream.
+pub fn read_tet<R: Read>(r: R, file: &str) -> Result<TetRead> {
+    parse_tet(&read_all(r, file)?, file)
+}
+
+/// VTK cell types that are volumes (other than the linear tet, 10).
+fn is_volume_cell(t: i64) -> bool {
+    matches!(t, 10..=16 | 24..=27 | 29 | 32 | 33 | 42 | 71..=74 | 78..=81)
+}
+
+const LABEL_NAMES: [&str; 9] = [
+    "region",
+    "gmsh:physical",
+    "medit:ref",
+    "CellEntityIds",
+    "tetgen:ref",
+    "label",
+    "labels",
+    "material",
+    "MaterialIds",
+];
+
+/// Parse a VTU tet mesh held in memory.
+pub fn parse_tet(data: &[u8], file: &str) -> Result<TetRead> {
+    let mut ctx = Ctx {
+        data,
+        file,
+        be: false,
+        header64: false,
+        zlib: false,
+        app: None,
+        app_end: data.len(),
+        app_offsets: Vec::new(),
+    };
+    let xml_end = match find(data, 0, b"<AppendedData") {
+        Some(p) => {
+            let mut q = p;
+            let tag = ctx
+                .next_tag(data, &mut q)?
+                .ok_or_else(|| ctx.err_at(p, "malformed AppendedData tag"))?;
+            let base64 = match tag.attr("encoding") {
+                Some(b"raw") => false,
+                Some(b"base64") => true,
+                Some(e) => {
+                    return Err(
+                        ctx.err_at(p, format!("unknown AppendedData encoding '{}'", show(e)))
+                    );
+                }
+                None => return Err(ctx.err_at(p, "AppendedData without an encoding")),
+            };
+            let us = data[tag.end..]
+                .iter()
+                .position(|&c| c == b'_')
+                .ok_or_else(|| ctx.err_at(p, "AppendedData without the '_' marker"))?;
+            let start = tag.end + us + 1;
+            ctx.app = Some((start, base64));
+            if base64 {
+                ctx.app_end = find(data, start, b"</AppendedData").unwrap_or(data.len());
+            }
+            p
+        }
+        None => data.len(),
+    };
+    let xml = &data[..xml_end];
+    let mut pos = 0;
+    let mut pieces: Vec<Piece> = Vec::new();
+    let mut cur: Option<Piece> = None;
+    let mut section: &[u8] = b"";
+    let mut seen_root = false;
+    while let Some(tag) = ctx.next_tag(xml, &mut pos)? {
+        match tag.name {
+            b"VTKFile" if !tag.closing => {
+                seen_root = true;
+                match tag.attr("type") {
+                    Some(b"UnstructuredGrid") => {}
+                    Some(t) => {
+                        return Err(ctx.err_at(
+                            tag.start,
+                            format!(
+                                "VTK file type '{}': only UnstructuredGrid (.vtu) is read",
+                                show(t)
+                            ),
+                        ));
+                    }
+                    None => return Err(ctx.err_at(tag.start, "VTKFile without a type")),
+                }
+                ctx.be = match tag.attr("byte_order") {
+                    Some(b"BigEndian") => true,
+                    Some(b"LittleEndian") | None => false,
+                    Some(o) => {
+                        return Err(
+                            ctx.err_at(tag.start, format!("unknown byte_order '{}'", show(o)))
+                        );
+                    }
+                };
+                ctx.header64 = match tag.attr("header_type") {
+                    Some(b"UInt64") => true,
+                    Some(b"UInt32") | None => false,
+                    Some(h) => {
+                        return Err(
+                            ctx.err_at(tag.start, format!("unsupported header_type '{}'", show(h)))
+                        );
+                    }
+                };
+                ctx.zlib = match tag.attr("compressor") {
+                    None | Some(b"") => false,
+                    Some(b"vtkZLibDataCompressor") => true,
+                    Some(c) => {
+                        return Err(ctx.err_at(
+                            tag.start,
+                            format!(
+                                "unsupported compressor '{}' (only vtkZLibDataCompressor)",
+                                show(c)
+                            ),
+                        ));
+                    }
+                };
+            }
+            b"Piece" if !tag.closing => {
+                if !seen_root {
+                    return Err(ctx.err_at(tag.start, "Piece outside VTKFile"));
+                }
+                let num = |k: &str| -> Result<usize> {
+                    let v = tag
+                        .attr(k)
+                        .ok_or_else(|| ctx.err_at(tag.start, format!("Piece without {k}")))?;
+                    crate::text::parse_u64(v)
+                        .and_then(|x| usize::try_from(x).ok())
+                        .ok_or_else(|| ctx.err_at(tag.start, format!("bad {k} '{}'", show(v))))
+                };
+                let p = Piece {
+                    npts: num("NumberOfPoints")?,
+                    ncells: num("NumberOfCells")?,
+                    ..Piece::default()
+                };
+                if tag.self_closing {
+                    pieces.push(p);
+                } else {
+                    cur = Some(p);
+                }
+            }
+            b"Piece" => {
+                if let Some(p) = cur.take() {
+                    pieces.push(p);
+                }
+            }
+            b"Points" | b"Cells" | b"CellData" | b"PointData" | b"FieldData" => {
+                section = if tag.closing || tag.self_closing {
+                    b""
+                } else {
+                    tag.name
+                };
+            }
+            b"DataArray" if !tag.closing => {
+                let ty_s = tag
+                    .attr("type")
+                    .ok_or_else(|| ctx.err_at(tag.start, "DataArray without a type"))?;
+                let ty = Ty::parse(ty_s).ok_or_else(|| {
+                    ctx.err_at(
+                        tag.start,
+                        format!("unsupported DataArray type '{}'", show(ty_s)),
+                    )
+                })?;
+                let ncomp = match tag.attr("NumberOfComponents") {
+                    Some(v) => crate::text::parse_u64(v)
+                        .filter(|&n| (1..=1024).contains(&n))
+                        .ok_or_else(|| {
+                            ctx.err_at(tag.start, format!("bad NumberOfComponents '{}'", show(v)))
+                        })? as usize,
+                    None => 1,
+                };
+                let format = match tag.attr("format") {
+                    Some(b"ascii") => Format::Ascii,
+                    Some(b"binary") => Format::Binary,
+                    Some(b"appended") => Format::Appended,
+                    Some(f) => {
+                        return Err(ctx
+                            .err_at(tag.start, format!("unknown DataArray format '{}'", show(f))));
+                    }
+                    None => Format::Ascii,
+                };
+                let offset = match tag.attr("offset") {
+                    Some(v) => crate::text::parse_u64(v)
+                        .and_then(|x| usize::try_from(x).ok())
+                        .ok_or_else(|| {
+                            ctx.err_at(tag.start, format!("bad offset '{}'", show(v)))
+                        })?,
+                    None => 0,
+                };
+                let content: &[u8] = if tag.self_closing {
+                    b""
+                } else {
+                    let end = find(xml, tag.end, b"</DataArray")
+                        .ok_or_else(|| ctx.err_at(tag.start, "DataArray without </DataArray>"))?;
+                    pos = end;
+                    // The data is the text before any child element (VTK adds
+                    // <InformationKey> elements after it).
+                    let text_end = find(&xml[..end], tag.end, b"<").unwrap_or(end);
+                    &xml[tag.end..text_end]
+                };
+                if format == Format::Appended {
+                    ctx.app_offsets.push(offset);
+                }
+                let a = ArrayRef {
+                    name: tag.attr("Name").unwrap_or(b""),
+                    ty,
+                    ncomp,
+                    format,
+                    offset,
+                    content,
+                    at: tag.start,
+                };
+                if let Some(p) = cur.as_mut() {
+                    match section {
+                        b"Points" if p.points.is_none() => p.points = Some(a),
+                        b"Cells" => match a.name {
+                            b"connectivity" => p.conn = Some(a),
+                            b"offsets" => p.offsets = Some(a),
+                            b"types" => p.types = Some(a),
+                            _ => {}
+                        },
+                        b"CellData" => p.cell_data.push(a),
+                        _ => {}
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    if !seen_root {
+        return Err(Error::format(
+            file,
+            "no VTKFile element: not a VTK XML file",
+        ));
+    }
+    if let Some(p) = cur.take() {
+        pieces.push(p);
+    }
+    ctx.app_offsets.sort_unstable();
+    ctx.app_offsets.dedup();
+
+    let mut points: Vec<[f64; 3]> = Vec::new();
+    let mut tets: Vec<[u32; 4]> = Vec::new();
+    let mut labels: Vec<u32> = Vec::new();
+    let mut skipped = 0;
+    for (pi, p) in pieces.iter().enumerate() {
+        let base = points.len();
+        if p.npts > 0 {
+            let a = p
+                .points
+                .as_ref()
+                .ok_or_else(|| Error::format(file, format!("piece {pi} has no Points array")))?;
+            if a.ncomp != 3 {
+                return Err(ctx.err_at(
+                    a.at,
+                    format!("Points with {} components, expected 3", a.ncomp),
+                ));
+            }
+            let cap = p
+                .npts
+                .checked_mul(3)
+                .ok_or_else(|| Error::format(file, "too many points"))?;
+            let v = match ctx.values(a, Some(cap))? {
+                Values::F(v) => v,
+                Values::I(v) => v.into_iter().map(|x| x as f64).collect(),
+            };
+            for (i, c) in v.chunks_exact(3).enumerate() {
+                if c.iter().any(|x| !x.is_finite()) {
+                    return Err(Error::element(
+                        file,
+                        "point",
+                        base + i,
+                        format!("non-finite coordinate {c:?}"),
+                    ));
+                }
+                points.push([c[0], c[1], c[2]]);
+            }
+            if points.len() > u32::MAX as usize {
+                return Err(Error::format(file, "too many points for 32-bit indices"));
+            }
+        }
+        if p.ncells == 0 {
+            continue;
+        }
+        fn need<'b, 'c>(
+            a: &'b Option<ArrayRef<'c>>,
+            n: &str,
+            pi: usize,
+            file: &str,
+        ) -> Result<&'b ArrayRef<'c>> {
+            a.as_ref()
+                .ok_or_else(|| Error::format(file, format!("piece {pi} has no '{n}' cell array")))
+        }
+        let offsets = ctx.ints(need(&p.offsets, "offsets", pi, file)?, Some(p.ncells))?;
+        let types = ctx.ints(need(&p.types, "types", pi, file)?, Some(p.ncells))?;
+        let nconn = offsets.last().copied().unwrap_or(0);
+        let nconn = usize::try_from(nconn).map_err(|_| {
+            Error::element(file, "cell", p.ncells - 1, format!("bad offset {nconn}"))
+        })?;
+        let conn = ctx.ints(need(&p.conn, "connectivity", pi, file)?, Some(nconn))?;
+        let label_arr = LABEL_NAMES
+            .iter()
+            .find_map(|n| {
+                p.cell_data
+                    .iter()
+                    .find(|a| a.name == n.as_bytes() && a.ncomp == 1)
+            })
+            .or_else(|| {
+                p.cell_data
+                    .iter()
+                    .find(|a| a.ncomp == 1 && !a.ty.is_float())
+            });
+        let lab = match label_arr {
+            Some(a) => Some((a, ctx.ints(a, Some(p.ncells))?)),
+            None => None,
+        };
+        let mut prev = 0usize;
+        for i in 0..p.ncells {
+            let end = offsets[i];
+            if end < prev as i64 || end > conn.len() as i64 {
+                return Err(Error::element(
+                    file,
+                    "cell",
+                    i,
+                    format!(
+                        "offset {end} out of order or past the connectivity ({} entries)",
+                        conn.len()
+                    ),
+                ));
+            }
+            let end = end as usize;
+            let c = &conn[prev..end];
+            prev = end;
+            if types[i] != 10 || c.len() != 4 {
+                if is_volume_cell(types[i]) {
+                    skipped += 1;
+                }
+                continue;
+            }
+            let mut t = [0u32; 4];
+            for (x, &v) in t.iter_mut().zip(c) {
+                if v < 0 || v as u64 >= p.npts as u64 {
+                    return Err(Error::element(
+                        file,
+                        "cell",
+                        i,
+                        format!("point index {v} out of range ({} points)", p.npts),
+                    ));
+                }
+                *x = (base + v as usize) as u32;
+            }
+            let l = match &lab {
+                Some((a, v)) => crate::common::label_of(v[i]).map_err(|e| {
+                    Error::element(file, "cell", i, format!("array '{}': {e}", show(a.name)))
+                })?,
+                None => 1,
+            };
+            tets.push(t);
+            labels.push(l);
+        }
+    }
+    let (flipped, degenerate) = orient_tets(&points, &mut tets);
+    Ok(TetRead {
+        mesh: TetMesh::new(points, tets, labels),
+        flipped,
+        degenerate,
+        skipped_elements: skipped,
+    })
+}

@@ -1,0 +1,11 @@
+//! Tests of biotet-io: one binary, a module per topic.
+
+mod atomic;
+mod common;
+mod dispatch;
+mod external;
+mod malformed;
+mod real_data;
+mod surface;
+mod tet;
+mod tri;

@@ -1,0 +1,101 @@
+//! Small meshes shared by the test modules.
+
+use biotet::geom::predicates::{Sign, orient3d};
+use biotet::{SurfaceMesh, TetMesh};
+
+/// The 8 corners of the cube [0, s]^3 offset by `o`, index = x + 2y + 4z.
+pub fn cube_points(o: [f64; 3], s: f64) -> Vec<[f64; 3]> {
+    (0..8)
+        .map(|i| {
+            [
+                o[0] + s * (i & 1) as f64,
+                o[1] + s * ((i >> 1) & 1) as f64,
+                o[2] + s * ((i >> 2) & 1) as f64,
+            ]
+        })
+        .collect()
+}
+
+/// Swap two vertices of every negatively oriented tet.
+pub fn orient_all(points: &[[f64; 3]], tets: &mut [[u32; 4]]) {
+    for t in tets {
+        let c = t.map(|i| points[i as usize]);
+        if orient3d(c[0], c[1], c[2], c[3]) == Sign::Negative {
+            t.swap(2, 3);
+        }
+    }
+}
+
+/// The cube split into 6 tets around its main diagonal 0–7 (Kuhn/Freudenthal split).
+pub fn cube6_tets(base: u32) -> Vec<[u32; 4]> {
+    let axes = [1u32, 2, 4];
+    let perms = [
+        [0, 1, 2],
+        [0, 2, 1],
+        [1, 0, 2],
+        [1, 2, 0],
+        [2, 0, 1],
+        [2, 1, 0],
+    ];
+    perms
+        .iter()
+        .map(|p| {
+            let a = axes[p[0]];
+            let b = a + axes[p[1]];
+            [base, base + a, base + b, base + 7]
+        })
+        .collect()
+}
+
+/// A unit cube as 6 positively oriented tets, one region.
+pub fn cube6() -> TetMesh {
+    let pts = cube_points([0.0; 3], 1.0);
+    let mut tets = cube6_tets(0);
+    orient_all(&pts, &mut tets);
+    TetMesh::new(pts, tets, vec![1; 6])
+}
+
+/// The outward-oriented boundary of the cube of [`cube_points`], 12 triangles, sides [1, 0].
+pub fn cube_surface(o: [f64; 3], s: f64) -> SurfaceMesh {
+    // Quads as corner indices, counter-clockwise seen from outside.
+    let quads = [
+        [0, 2, 3, 1], // z = 0, normal -z
+        [4, 5, 7, 6], // z = 1
+        [0, 1, 5, 4], // y = 0
+        [2, 6, 7, 3], // y = 1
+        [0, 4, 6, 2], // x = 0
+        [1, 3, 7, 5], // x = 1
+    ];
+    let mut tris = Vec::new();
+    for q in quads {
+        // Split along the diagonal through corner 0 or 7 to match the Kuhn split's faces.
+        if q.contains(&0) || q.contains(&7) {
+            let k = q.iter().position(|&v| v == 0 || v == 7).unwrap_or(0);
+            let r = |i: usize| q[(k + i) % 4];
+            tris.push([r(0), r(1), r(2)]);
+            tris.push([r(0), r(2), r(3)]);
+        }
+    }
+    SurfaceMesh::closed(cube_points(o, s), tris, 1)
+}
+
+/// Two unit cubes side by side along x, labels 1 and 2, sharing the face x = 1.
+pub fn two_cubes() -> TetMesh {
+    let mut pts = cube_points([0.0; 3], 1.0);
+    let right = cube_points([1.0, 0.0, 0.0], 1.0);
+    // Reuse the shared face's points: right cube corners with x = 0 are left corners with x = 1.
+    let mut map = [0u32; 8];
+    for (i, p) in right.iter().enumerate() {
+        if let Some(j) = pts.iter().position(|q| q == p) {
+            map[i] = j as u32;
+        } else {
+            map[i] = pts.len() as u32;
+            pts.push(*p);
+        }
+    }
+    let mut tets: Vec<[u32; 4]> = cube6_tets(0);
+    tets.extend(cube6_tets(0).iter().map(|t| t.map(|v| map[v as usize])));
+    orient_all(&pts, &mut tets);
+    let labels = [vec![1; 6], vec![2; 6]].concat();
+    TetMesh::new(pts, tets, labels)
+}
