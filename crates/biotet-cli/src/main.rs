@@ -44,8 +44,15 @@ enum Command {
     Validate(cmd::validate::Args),
 }
 
+/// Exit status when the input was read and judged invalid (a mesh that fails `check`, a surface
+/// that `validate` refuses).
+pub const EXIT_INVALID: u8 = 1;
+/// Exit status when the command could not do its job (unreadable file, bad option, I/O error).
+pub const EXIT_ERROR: u8 = 2;
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    let json = std::env::args().any(|a| a == "--json");
     let result = match cli.command {
         Command::Quality(a) => cmd::quality::run(a),
         Command::Check(a) => cmd::check::run(a),
@@ -55,8 +62,31 @@ fn main() -> ExitCode {
     match result {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {e:#}");
-            ExitCode::FAILURE
+            let msg = format!("{e:#}");
+            eprintln!("error: {msg}");
+            if json {
+                emit(&serde_json::json!({ "error": msg }).to_string());
+            }
+            // A surface refused by validation is an invalid input, not a failure to run.
+            let refused = e
+                .downcast_ref::<biotet::mesh::validate::SurfaceError>()
+                .is_some();
+            ExitCode::from(if refused { EXIT_INVALID } else { EXIT_ERROR })
         }
+    }
+}
+
+/// Print a line on stdout. A closed pipe (`biotet quality m.vtu | head`) ends the program
+/// quietly, as for any Unix filter, instead of panicking.
+pub fn emit(text: &str) {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    let r = writeln!(out, "{}", text.trim_end_matches('\n')).and_then(|_| out.flush());
+    if let Err(e) = r {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            std::process::exit(0);
+        }
+        eprintln!("error: writing to stdout: {e}");
+        std::process::exit(EXIT_ERROR as i32);
     }
 }

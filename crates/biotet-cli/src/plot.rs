@@ -19,7 +19,7 @@
 use std::io::Write as _;
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use biotet::quality::{Histogram, QualityReport, REGULAR_SOLID_ANGLE, TriQualityReport};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -354,36 +354,11 @@ fn draw_panel(area: &DrawingArea<SVGBackend, Shift>, p: &Panel) -> Result<()> {
 /// place, so the target is either the old file or the whole new one.
 fn write_svg(path: &Path, title: &str, panels: [&Panel; 2]) -> Result<()> {
     let svg = render(title, panels)?;
-    write_atomic(path, svg.as_bytes()).with_context(|| format!("writing {}", path.display()))
-}
-
-fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let nanos = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| d.subsec_nanos());
-    let tmp = dir.join(format!(".{name}.{}.{nanos}.tmp", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        drop(f);
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
+    biotet_io::atomic::write_atomic(path, |w| {
+        w.write_all(svg.as_bytes())
+            .map_err(|e| biotet_io::Error::io(&path.display().to_string(), e))
+    })?;
+    Ok(())
 }
 
 #[cfg(test)]

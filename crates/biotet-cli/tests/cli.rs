@@ -293,7 +293,8 @@ fn missing_and_garbage_inputs_fail_cleanly_and_write_nothing() {
     .unwrap();
     for input in [&missing, &garbage] {
         let out = biotet(&["convert", s(input), "-o", s(&out_path)]);
-        assert_eq!(out.status.code(), Some(1));
+        // 2: the command could not run (1 is kept for "read and judged invalid").
+        assert_eq!(out.status.code(), Some(2));
         let msg = stderr(&out);
         assert!(msg.starts_with("error: "), "{msg}");
         assert!(
@@ -319,4 +320,107 @@ fn check_fails_when_a_surface_triangle_is_missing() {
     ]);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stdout).contains("INVALID"));
+}
+
+#[test]
+fn json_errors_are_json_too() {
+    let out = biotet(&["quality", "/nonexistent/m.vtu", "--json"]);
+    assert_eq!(out.status.code(), Some(2));
+    let j: Value = serde_json::from_slice(&out.stdout).expect("a JSON error object");
+    assert!(j["error"].as_str().unwrap().contains("m.vtu"));
+}
+
+#[test]
+fn a_closed_pipe_ends_quietly() {
+    use std::io::Read;
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_biotet"))
+        .args(["quality", s(&example())])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Read one byte and hang up, like `| head -c 1`.
+    let mut first = [0u8; 1];
+    child
+        .stdout
+        .as_mut()
+        .unwrap()
+        .read_exact(&mut first)
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+}
+
+#[test]
+fn inverted_tets_in_a_file_reach_the_checker_and_the_report() {
+    // Two tets over the triangle (0,1,2): apexes on opposite sides is a valid mesh; moving the
+    // second apex to the same side as the first folds it (one tet inverted, overlapping).
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, apex: f64| {
+        let p = dir.path().join(name);
+        let text = format!(
+            "MeshVersionFormatted 2\nDimension 3\nVertices\n5\n0 0 0 1\n1 0 0 1\n0 1 0 1\n\
+             0 0 1 1\n0.2 0.2 {apex} 1\nTetrahedra\n2\n1 2 3 4 1\n1 3 2 5 1\nEnd\n"
+        );
+        std::fs::write(&p, text).unwrap();
+        p
+    };
+    let good = write("good.mesh", -1.0);
+    let folded = write("folded.mesh", 0.5);
+    let j = json_of(&biotet(&["check", s(&good), "--json"]));
+    assert_eq!(j["valid"], true);
+    let out = biotet(&["check", s(&folded), "--json"]);
+    assert_eq!(out.status.code(), Some(1));
+    let j: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(j["valid"], false);
+    assert_eq!(j["n_nonpositive"], 1);
+    let q = json_of(&biotet(&["quality", s(&folded), "--json"]));
+    assert_eq!(q["n_inverted"], 1);
+}
+
+#[test]
+fn quality_figures_of_a_cube_in_six_tets_through_the_cli() {
+    // The Kuhn split of the unit cube: each tet has dihedral angles 45, 45, 60, 90, 90, 90
+    // degrees, volume 1/6, edge lengths 1, 1, 1, sqrt2, sqrt2, sqrt3 so that
+    // q = 12 (3/6)^(2/3) / 10 = 0.755953 (worked out in crates/biotet/tests/all/quality.rs).
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("cube.mesh");
+    let mut text = String::from("MeshVersionFormatted 2\nDimension 3\nVertices\n8\n");
+    for i in 0..8 {
+        text += &format!("{} {} {} 0\n", i & 1, (i >> 1) & 1, (i >> 2) & 1);
+    }
+    text += "Tetrahedra\n6\n";
+    // Axis orders; the odd permutations (xzy, yxz, zyx) get two vertices swapped so that every
+    // tet is positively oriented.
+    for (a, b, odd) in [
+        (1, 2, false),
+        (1, 4, true),
+        (2, 1, true),
+        (2, 4, false),
+        (4, 1, false),
+        (4, 2, true),
+    ] {
+        let (u, v) = (a + 1, a + b + 1);
+        let (u, v) = if odd { (v, u) } else { (u, v) };
+        text += &format!("1 {u} {v} 8 1\n");
+    }
+    text += "End\n";
+    std::fs::write(&p, text).unwrap();
+    let j = json_of(&biotet(&["quality", s(&p), "--json"]));
+    assert_eq!(j["n_tets"], 6);
+    let close = |k: &str, v: f64| {
+        let got = j[k].as_f64().unwrap();
+        assert!((got - v).abs() < 1e-9, "{k}: {got} vs {v}");
+    };
+    close("volume", 1.0);
+    close("min_dihedral_deg", 45.0);
+    close("max_dihedral_deg", 90.0);
+    close("min_q", 0.755_952_629_936_923_9);
+    close("mean_q", 0.755_952_629_936_923_9);
+    close("min_solid_angle_sr", std::f64::consts::PI / 12.0);
+    assert_eq!(j["n_dihedral_lt_20"], 0);
+    assert_eq!(j["n_dihedral_gt_160"], 0);
 }

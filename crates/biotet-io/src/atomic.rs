@@ -69,6 +69,8 @@ where
             .into_inner()
             .map_err(|e| Error::io(&name, e.into_error()))?;
         tmp.flush().map_err(|e| Error::io(&name, e))?;
+        // On disk before the rename, so a crash never leaves a renamed but empty file.
+        tmp.as_file().sync_all().map_err(|e| Error::io(&name, e))?;
         temps.push(tmp);
     }
     for (tmp, p) in temps.into_iter().zip(paths) {

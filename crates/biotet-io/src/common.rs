@@ -16,40 +16,48 @@ pub(crate) fn read_all<R: Read>(mut r: R, file: &str) -> Result<Vec<u8>> {
     Ok(data)
 }
 
-/// Make every tet positively oriented by swapping its last two vertices when `orient3d` says
-/// it is negative. Returns `(flipped, degenerate)`; degenerate (zero-volume) tets are kept.
-/// Indices must be in range.
+/// Bring a file's orientation convention to ours. Other tools may store every tet the other way
+/// round (negative signed volume); when every non-degenerate tet is negative, all of them are
+/// reoriented by swapping their last two vertices. A file that MIXES orientations holds inverted
+/// elements: it is left as it is, so the checker and the quality report see them. Returns
+/// `(flipped, degenerate)`; degenerate (zero-volume) tets are kept and counted.
 pub(crate) fn orient_tets(points: &[[f64; 3]], tets: &mut [[u32; 4]]) -> (usize, usize) {
-    let (mut flipped, mut degenerate) = (0, 0);
-    for t in tets.iter_mut() {
-        let p = |i: usize| points[t[i] as usize];
-        match orient3d(p(0), p(1), p(2), p(3)) {
-            Sign::Negative => {
-                t.swap(2, 3);
-                flipped += 1;
-            }
-            Sign::Zero => degenerate += 1,
-            Sign::Positive => {}
-        }
-    }
-    (flipped, degenerate)
+    let signs: Vec<Sign> = tets
+        .iter()
+        .map(|t| {
+            let p = |i: usize| points[t[i] as usize];
+            orient3d(p(0), p(1), p(2), p(3))
+        })
+        .collect();
+    reorient(&signs, tets, |t| t.swap(2, 3))
 }
 
-/// Make every triangle counter-clockwise; returns `(flipped, degenerate)`.
+/// Like [`orient_tets`] for 2D triangles: a file that is clockwise throughout is made
+/// counter-clockwise; mixed orientations are left for the checker.
 pub(crate) fn orient_tris(points: &[[f64; 2]], tris: &mut [[u32; 3]]) -> (usize, usize) {
-    let (mut flipped, mut degenerate) = (0, 0);
-    for t in tris.iter_mut() {
-        let p = |i: usize| points[t[i] as usize];
-        match orient2d(p(0), p(1), p(2)) {
-            Sign::Negative => {
-                t.swap(1, 2);
-                flipped += 1;
-            }
-            Sign::Zero => degenerate += 1,
-            Sign::Positive => {}
+    let signs: Vec<Sign> = tris
+        .iter()
+        .map(|t| {
+            let p = |i: usize| points[t[i] as usize];
+            orient2d(p(0), p(1), p(2))
+        })
+        .collect();
+    reorient(&signs, tris, |t| t.swap(1, 2))
+}
+
+fn reorient<T>(signs: &[Sign], cells: &mut [T], flip: impl Fn(&mut T)) -> (usize, usize) {
+    let negative = signs.iter().filter(|&&s| s == Sign::Negative).count();
+    let degenerate = signs.iter().filter(|&&s| s == Sign::Zero).count();
+    let all_negative = negative > 0 && negative + degenerate == signs.len();
+    if !all_negative {
+        return (0, degenerate);
+    }
+    for (c, &s) in cells.iter_mut().zip(signs) {
+        if s == Sign::Negative {
+            flip(c);
         }
     }
-    (flipped, degenerate)
+    (negative, degenerate)
 }
 
 /// A label from an integer read from a file.

@@ -91,7 +91,8 @@ pub enum Error {
 }
 
 impl Error {
-    pub(crate) fn io(file: &str, source: io::Error) -> Error {
+    /// An I/O error on `file`.
+    pub fn io(file: &str, source: io::Error) -> Error {
         Error::Io {
             file: file.to_string(),
             error: source,

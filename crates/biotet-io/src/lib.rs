@@ -18,9 +18,11 @@
 //!   coordinates or out-of-range indices ([`Error::InvalidMesh`]).
 //! - Every write is atomic ([`atomic`]): temporary file(s) next to the target, renamed when
 //!   complete; nothing is left behind on error.
-//! - Tet and triangle readers return positively oriented cells: a tet with negative volume
-//!   (by the exact [`biotet::geom::predicates::orient3d`]) gets its last two vertices swapped,
-//!   counted in [`TetRead::flipped`]; likewise clockwise triangles ([`TriRead::flipped`]).
+//! - Tet and triangle readers bring a file's orientation convention to ours: when every
+//!   non-degenerate tet has negative volume (by the exact
+//!   [`biotet::geom::predicates::orient3d`]), all get their last two vertices swapped, counted in
+//!   [`TetRead::flipped`]; likewise clockwise triangle meshes ([`TriRead::flipped`]). A file that
+//!   mixes orientations holds inverted elements and is returned as it is, for the checker.
 //! - Readers never panic on malformed input; every error names the file and the line (text) or
 //!   element index (binary) and the reason ([`Error`]).
 //! - Tet writers also store the boundary and interface faces between labels, grouped and
@@ -41,12 +43,14 @@ pub mod medit;
 pub mod obj;
 pub mod off;
 pub mod ply;
+pub mod points;
 pub mod stl;
 pub mod tetgen;
 mod text;
 pub mod vtu;
 
 pub use error::{Error, Result};
+pub use points::read_points;
 pub use tetgen::{TetgenFiles, TetgenOptions};
 pub use vtu::VtuEncoding;
 

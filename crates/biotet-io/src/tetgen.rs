@@ -81,7 +81,7 @@ pub struct TetgenOptions {
     pub zero_based: bool,
 }
 
-fn parse_node<const D: usize>(data: &[u8], file: &str) -> Result<(Vec<[f64; D]>, u64)> {
+pub(crate) fn parse_node<const D: usize>(data: &[u8], file: &str) -> Result<(Vec<[f64; D]>, u64)> {
     let mut lx = Lexer::new(data, file, Some(b'#'));
     let mut toks = Vec::new();
     if !lx.line_tokens(&mut toks) {

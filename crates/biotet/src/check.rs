@@ -7,6 +7,7 @@
 use crate::geom::predicates::{Sign, orient3d};
 use crate::mesh::surface::SurfaceMesh;
 use crate::mesh::tet::{NO_NEIGHBOR, TET_FACES, TetMesh, sorted3};
+use crate::mesh::validate::{ValidateOptions, validate_surface};
 use rustc_hash::FxHashMap;
 use serde::Serialize;
 use std::fmt;
@@ -43,6 +44,10 @@ pub struct CheckReport {
     pub n_nonfinite_points: usize,
     /// Label array length differs from the tet count (0 or 1).
     pub n_label_errors: usize,
+    /// Why the mesh's boundary faces do not form a closed, embedded, outward surface (`None`
+    /// when they do). Together with positive tets and conforming faces this proves that the
+    /// tets cover their domain exactly once: no overlap, no fold.
+    pub boundary_problem: Option<String>,
     /// Surface conformity, when a surface was given.
     pub surface: Option<SurfaceConformity>,
     /// Human-readable descriptions of the first offenders of each kind.
@@ -114,6 +119,17 @@ pub fn check(mesh: &TetMesh, surface: Option<&SurfaceMesh>) -> CheckReport {
     };
     let np = mesh.points.len();
 
+    if mesh.tets.is_empty() {
+        r.problems.push("the mesh has no tets".to_string());
+    }
+    if mesh.tets.len() >= 1 << 30 {
+        r.n_bad_tets += 1;
+        r.problems.push(format!(
+            "{} tets: more than 2^30 are not supported",
+            mesh.tets.len()
+        ));
+        return r;
+    }
     if mesh.labels.len() != mesh.tets.len() {
         r.n_label_errors = 1;
         r.problems.push(format!(
@@ -259,6 +275,18 @@ pub fn check(mesh: &TetMesh, surface: Option<&SurfaceMesh>) -> CheckReport {
         }
     }
 
+    let locally_ok = r.n_bad_tets == 0
+        && r.n_nonpositive == 0
+        && r.n_overshared_faces == 0
+        && r.n_misoriented_faces == 0
+        && r.n_nonfinite_points == 0;
+    if locally_ok && !mesh.tets.is_empty() {
+        r.boundary_problem = boundary_embedding(mesh, &boundary);
+        if let Some(p) = &r.boundary_problem {
+            r.problems.push(format!("boundary surface: {p}"));
+        }
+    }
+
     if let Some(s) = surface {
         r.surface = Some(check_surface(
             mesh,
@@ -274,6 +302,8 @@ pub fn check(mesh: &TetMesh, surface: Option<&SurfaceMesh>) -> CheckReport {
         s.n_found == s.n_triangles && s.n_extra_boundary_faces == 0 && s.n_label_mismatch == 0
     });
     r.valid = s_ok
+        && !mesh.tets.is_empty()
+        && r.boundary_problem.is_none()
         && r.n_bad_tets == 0
         && r.n_nonpositive == 0
         && r.n_overshared_faces == 0
@@ -284,6 +314,31 @@ pub fn check(mesh: &TetMesh, surface: Option<&SurfaceMesh>) -> CheckReport {
         && r.n_nonfinite_points == 0
         && r.n_label_errors == 0;
     r
+}
+
+/// Validate the boundary faces as one closed surface (outward, as tet faces are): closed,
+/// manifold, consistently oriented, not self-intersecting, and no shell inside out. Positive tets
+/// with conforming faces cover each point a number of times equal to the winding number of
+/// their boundary around it, so an embedded outward boundary means every point of the domain is
+/// covered exactly once: this finds tets that overlap without sharing a face.
+fn boundary_embedding(
+    mesh: &TetMesh,
+    boundary: &FxHashMap<[u32; 3], (u32, u32)>,
+) -> Option<String> {
+    let mut faces: Vec<(u32, u32)> = boundary.values().copied().collect();
+    faces.sort_unstable();
+    let triangles: Vec<[u32; 3]> = faces
+        .iter()
+        .map(|&(t, f)| mesh.face(t as usize, f as usize))
+        .collect();
+    let mut surface = SurfaceMesh::closed(mesh.points.clone(), triangles, 1);
+    let opts = ValidateOptions {
+        fix_inward: false,
+        ..ValidateOptions::default()
+    };
+    validate_surface(&mut surface, &opts)
+        .err()
+        .map(|e| format!("{e} (triangle indices are boundary faces in (tet, face) order)"))
 }
 
 fn show_nb(n: u32) -> String {
@@ -317,7 +372,7 @@ fn check_surface(
     };
     let multi_region = mesh.regions().len() > 1;
     let mut per_pair: FxHashMap<[u32; 2], (usize, usize)> = FxHashMap::default();
-    let mut outer_faces_seen = 0usize;
+    let mut outer_matched: Vec<[u32; 3]> = Vec::new();
     let mut listed = 0usize;
     let mut list = |problems: &mut Vec<String>, msg: String| {
         listed += 1;
@@ -371,6 +426,9 @@ fn check_surface(
         // triangle, since tet faces are outward) or in front?
         let mut ok = true;
         let outer = sides[0] == 0 || sides[1] == 0;
+        if outer && hits.len() == 1 {
+            outer_matched.push(key);
+        }
         if outer {
             if hits.len() != 1 {
                 c.n_outer_not_boundary += 1;
@@ -415,14 +473,12 @@ fn check_surface(
         if ok {
             c.n_found += 1;
             per_pair.entry(pair).or_default().1 += 1;
-            if outer {
-                outer_faces_seen += 1;
-            }
         }
     }
-    // Boundary faces that are no outer triangle: count boundary faces minus the outer triangles
-    // that matched one (a duplicated surface triangle would be caught by surface validation).
-    c.n_extra_boundary_faces = boundary.len().saturating_sub(outer_faces_seen);
+    // Boundary faces that are no outer triangle (whatever their labels).
+    outer_matched.sort_unstable();
+    outer_matched.dedup();
+    c.n_extra_boundary_faces = boundary.len() - outer_matched.len();
     if c.n_extra_boundary_faces > 0 && c.n_found == c.n_triangles {
         problems.push(format!(
             "{} mesh boundary faces are not triangles of the surface",

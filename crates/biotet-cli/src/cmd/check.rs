@@ -33,9 +33,9 @@ pub fn run(a: Args) -> Result<ExitCode> {
     let report = biotet::check::check(&mesh, surface.as_ref());
     drop(stage);
     if a.common.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        crate::emit(&serde_json::to_string_pretty(&report)?);
     } else if !a.common.quiet {
-        print!("{}: {report}", a.mesh.display());
+        crate::emit(&format!("{}: {report}", a.mesh.display()));
     }
     Ok(if report.valid {
         ExitCode::SUCCESS

@@ -73,16 +73,16 @@ pub fn run(a: Args) -> Result<ExitCode> {
         } else {
             "n_triangles"
         };
-        println!(
-            "{}",
-            json!({"input": a.input, "output": a.output, "n_points": n_points, key: n_elements})
+        crate::emit(
+            &json!({"input": a.input, "output": a.output, "n_points": n_points, key: n_elements})
+                .to_string(),
         );
     } else if !a.common.quiet {
-        println!(
+        crate::emit(&format!(
             "{} -> {}: {n_points} points, {n_elements} {what}",
             a.input.display(),
             a.output.display()
-        );
+        ));
     }
     Ok(ExitCode::SUCCESS)
 }

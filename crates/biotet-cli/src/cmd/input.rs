@@ -9,12 +9,22 @@ use std::path::Path;
 /// Read a tet mesh, telling the user about tets that had to be reoriented.
 pub fn tet_mesh(path: &Path, common: Common) -> Result<TetMesh> {
     let read = biotet_io::read_tet_mesh(path)?;
-    if read.flipped > 0 && !common.quiet && !common.json {
-        eprintln!(
-            "note: {}: {} negatively oriented tets were reoriented",
-            path.display(),
-            read.flipped
-        );
+    if !common.quiet && !common.json {
+        if read.flipped > 0 {
+            eprintln!(
+                "note: {}: stored with the opposite orientation convention; all {} tets were \
+                 reoriented",
+                path.display(),
+                read.flipped
+            );
+        }
+        if read.skipped_elements > 0 {
+            eprintln!(
+                "warning: {}: {} volume elements that are not linear tets were ignored",
+                path.display(),
+                read.skipped_elements
+            );
+        }
     }
     Ok(read.mesh)
 }
@@ -36,8 +46,10 @@ pub fn surface(path: &Path, common: Common) -> Result<(SurfaceMesh, ValidationRe
         }
         if report.flipped_inward {
             eprintln!(
-                "note: {}: the surface was oriented inward; all triangles were flipped",
-                path.display()
+                "note: {}: {} of {} triangles faced inward and were flipped",
+                path.display(),
+                report.n_flipped_triangles,
+                report.n_triangles
             );
         }
     }

@@ -59,9 +59,9 @@ pub fn run(a: Args) -> Result<ExitCode> {
 
 fn print<R: serde::Serialize + std::fmt::Display>(report: &R, common: Common) -> Result<()> {
     if common.json {
-        println!("{}", serde_json::to_string_pretty(report)?);
+        crate::emit(&serde_json::to_string_pretty(report)?);
     } else if !common.quiet {
-        print!("{report}");
+        crate::emit(&report.to_string());
     }
     Ok(())
 }

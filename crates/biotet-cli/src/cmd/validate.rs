@@ -24,20 +24,17 @@ pub fn run(a: Args) -> Result<ExitCode> {
         let (mesh, report) = super::input::surface(path, a.common)?;
         drop(stage);
         if !a.common.quiet && !a.common.json {
-            println!(
+            crate::emit(&format!(
                 "{}: valid: {} points, {} triangles\n{report}",
                 path.display(),
                 mesh.points.len(),
                 mesh.triangles.len()
-            );
+            ));
         }
         out.push(json!({"file": path, "report": report}));
     }
     if a.common.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&json!({"surfaces": out}))?
-        );
+        crate::emit(&serde_json::to_string_pretty(&json!({"surfaces": out}))?);
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -138,19 +138,29 @@ fn orphan_points_round_trip() {
 }
 
 #[test]
-fn negative_tets_are_flipped_in_every_format() {
+fn negative_convention_is_flipped_and_mixed_orientation_kept_in_every_format() {
     let m = moderate();
-    let mut bad = m.clone();
-    for t in bad.tets.iter_mut().step_by(3) {
+    // A file written with the other convention: every tet negative.
+    let mut other = m.clone();
+    for t in other.tets.iter_mut() {
         t.swap(0, 1);
     }
-    let n_bad = bad.tets.len().div_ceil(3);
+    // A file with some inverted tets: they must reach the checker as they are.
+    let mut mixed = m.clone();
+    for t in mixed.tets.iter_mut().step_by(3) {
+        t.swap(0, 1);
+    }
     for f in ALL {
-        let r = read(f, &write(f, &bad)).unwrap();
-        assert_eq!(r.flipped, n_bad, "{f:?}");
+        let r = read(f, &write(f, &other)).unwrap();
+        assert_eq!(r.flipped, m.tets.len(), "{f:?}");
         assert_eq!(r.degenerate, 0);
         // Fixed orientation: the same tets as the positive original, up to even permutation.
         assert_same_tet(&m, &r.mesh, &format!("{f:?}"));
+        let r = read(f, &write(f, &mixed)).unwrap();
+        assert_eq!(r.flipped, 0, "{f:?}");
+        assert_same_tet(&mixed, &r.mesh, &format!("{f:?}"));
+        let report = biotet::check::check(&r.mesh, None);
+        assert_eq!(report.n_nonpositive, m.tets.len().div_ceil(3), "{f:?}");
     }
 }
 
@@ -322,7 +332,10 @@ $Elements\n5\n7 4 2 6 1 10 20 30 40\n3 4 2 5 1 20 30 40 50\n4 2 2 1 1 10 20 30\n
     // Order by element tag: 3, 6, 7.
     assert_eq!(r.mesh.labels, vec![9, 1, 6]);
     assert_eq!(r.skipped_elements, 1);
-    assert_eq!(r.flipped, 1); // element 6: 10 30 20 40 is negative
+    // Element 6 (10 30 20 40) is negative while the others are positive: an inverted element,
+    // kept as it is for the checker rather than silently repaired.
+    assert_eq!(r.flipped, 0);
+    assert_eq!(biotet::check::check(&r.mesh, None).n_nonpositive, 1);
 }
 
 #[test]

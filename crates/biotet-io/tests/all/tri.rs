@@ -49,16 +49,23 @@ fn all_pairs_round_trip() {
 }
 
 #[test]
-fn clockwise_triangles_are_flipped() {
+fn clockwise_meshes_are_flipped_and_mixed_ones_kept() {
     let m = tri_grid(4, 0.0);
     let mut cw = m.clone();
-    for t in cw.triangles.iter_mut().step_by(2) {
+    for t in cw.triangles.iter_mut() {
+        t.swap(0, 1);
+    }
+    let mut mixed = m.clone();
+    for t in mixed.triangles.iter_mut().step_by(2) {
         t.swap(0, 1);
     }
     for f in ALL {
         let r = read(f, &write(f, &cw));
-        assert_eq!(r.flipped, 16, "{f:?}");
+        assert_eq!(r.flipped, m.triangles.len(), "{f:?}");
         assert_same_tri(&m, &r.mesh, &format!("{f:?}"));
+        let r = read(f, &write(f, &mixed));
+        assert_eq!(r.flipped, 0, "{f:?}");
+        assert_same_tri(&mixed, &r.mesh, &format!("{f:?}"));
     }
 }
 

@@ -11,8 +11,8 @@
 //! tet is then either overwritten by a new tet or put on the free list, where it stays flagged.
 
 use super::Delaunay;
-use crate::geom::filter::{insphere_filter, orient3d};
-use crate::geom::predicates::{Sign, insphere_sos};
+use crate::geom::filter::{insphere_filter, insphere_sos_slow, orient3d};
+use crate::geom::predicates::Sign;
 use crate::mesh::tet::TET_FACES;
 
 /// The infinite vertex (internal id).
@@ -46,8 +46,8 @@ pub(crate) struct Boundary {
 /// cavity-boundary edge `(a, b)` and the link of the face that holds it.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct EdgeSlot {
-    pub a: u32,
-    pub b: u32,
+    /// `a << 32 | b`.
+    pub key: u64,
     pub link: u32,
     pub stamp: u32,
 }
@@ -99,206 +99,272 @@ pub(crate) enum Located {
     Duplicate(u32),
 }
 
-impl Delaunay {
-    #[inline(always)]
-    fn pt(&self, v: u32) -> [f64; 3] {
-        // SAFETY-free: bounds-checked indexing; internal ids are always < pts.len().
-        self.pts[v as usize]
-    }
+#[inline(always)]
+fn xorshift(x: &mut u32) -> u32 {
+    *x ^= *x << 13;
+    *x ^= *x >> 17;
+    *x ^= *x << 5;
+    *x
+}
 
-    #[inline(always)]
-    fn next_rand(&mut self) -> u32 {
-        // xorshift32
-        let mut x = self.walk_rng;
-        x ^= x << 13;
-        x ^= x >> 17;
-        x ^= x << 5;
-        self.walk_rng = x;
-        x
-    }
-
-    /// Remembering stochastic walk from `self.last` to a tet in conflict with `p`.
-    #[inline(never)]
-    pub(crate) fn locate(&mut self, p: [f64; 3]) -> Located {
-        let mut t = self.last;
-        let mut from = 4usize;
-        loop {
-            let tt = self.tets[t as usize];
-            if tt.v[3] == INF {
-                // Ghost: its finite face 3 = (v0, v2, v1) faces the hull's interior.
-                let (a, b, c) = (self.pt(tt.v[0]), self.pt(tt.v[2]), self.pt(tt.v[1]));
-                if orient3d(a, b, c, p) == Sign::Negative {
-                    return Located::Conflict(t);
-                }
-                from = (tt.n[3] & 3) as usize;
-                t = tt.n[3] >> 2;
-                continue;
-            }
-            let q = [
-                self.pt(tt.v[0]),
-                self.pt(tt.v[1]),
-                self.pt(tt.v[2]),
-                self.pt(tt.v[3]),
-            ];
-            let r = self.next_rand() as usize;
-            let mut moved = false;
-            for k in 0..4 {
-                let i = (r + k) & 3;
-                if i == from {
-                    continue;
-                }
-                let l = TET_FACES[i];
-                if orient3d(q[l[0]], q[l[1]], q[l[2]], p) == Sign::Positive {
-                    from = (tt.n[i] & 3) as usize;
-                    t = tt.n[i] >> 2;
-                    moved = true;
-                    break;
-                }
-            }
-            if !moved {
-                for k in 0..4 {
-                    if q[k] == p {
-                        return Located::Duplicate(tt.v[k]);
-                    }
-                }
+/// Remembering stochastic walk from `start` to a tet in conflict with `p`: a finite tet whose
+/// closure contains `p` (then `p` is strictly inside its circumsphere unless it is a vertex), or
+/// a ghost whose hull face `p` is strictly outside of.
+fn locate(tets: &[Tet], pts: &[[f64; 3]], start: u32, p: [f64; 3], rng: &mut u32) -> Located {
+    let mut t = start;
+    let mut from = 4usize;
+    loop {
+        let tt = tets[t as usize];
+        if tt.v[3] == INF {
+            // Ghost: its finite face 3 = (v0, v2, v1) faces the hull's interior.
+            let (a, b, c) = (
+                pts[tt.v[0] as usize],
+                pts[tt.v[2] as usize],
+                pts[tt.v[1] as usize],
+            );
+            if orient3d(a, b, c, p) == Sign::Negative {
                 return Located::Conflict(t);
             }
+            from = (tt.n[3] & 3) as usize;
+            t = tt.n[3] >> 2;
+            continue;
         }
-    }
-
-    /// In-sphere conflict of the finite tet `u` (possibly flagged) with vertex `vi` at `p`,
-    /// decided with Simulation of Simplicity by public vertex number.
-    #[inline(always)]
-    fn finite_conflict(&self, u: u32, vi: u32, p: [f64; 3]) -> bool {
-        let mut v = self.tets[u as usize].v;
-        v[0] &= !FLAG;
-        let q = [self.pt(v[0]), self.pt(v[1]), self.pt(v[2]), self.pt(v[3])];
-        match insphere_filter(q[0], q[1], q[2], q[3], p) {
-            Some(s) => s == Sign::Positive,
-            None => self.finite_conflict_exact(v, vi, p),
-        }
-    }
-
-    #[inline(never)]
-    fn finite_conflict_exact(&self, v: [u32; 4], vi: u32, p: [f64; 3]) -> bool {
-        let q = [
-            self.pt(v[0]),
-            self.pt(v[1]),
-            self.pt(v[2]),
-            self.pt(v[3]),
-            p,
-        ];
-        let ids = [
-            self.ids[v[0] as usize],
-            self.ids[v[1] as usize],
-            self.ids[v[2] as usize],
-            self.ids[v[3] as usize],
-            self.ids[vi as usize],
-        ];
-        insphere_sos(q, ids) == Sign::Positive
-    }
-
-    /// Conflict of the (unflagged) tet `u` with vertex `vi` at `p`.
-    ///
-    /// A ghost `(a, b, c, ∞)` conflicts when `p` is strictly on the outer side of its hull face;
-    /// when `p` is on the face's plane it conflicts exactly when the finite tet across the hull
-    /// face does: both are the perturbed in-circle test of `p` against the circle of `abc`, the
-    /// limit of the in-sphere test of the ghost as its fourth vertex goes to infinity (see the
-    /// module docs of [`super`]).
-    #[inline(always)]
-    fn conflict(&self, u: u32, vi: u32, p: [f64; 3]) -> bool {
-        let t = &self.tets[u as usize];
-        if t.v[3] == INF {
-            let (a, b, c) = (self.pt(t.v[0]), self.pt(t.v[2]), self.pt(t.v[1]));
-            match orient3d(a, b, c, p) {
-                Sign::Negative => true,
-                Sign::Positive => false,
-                Sign::Zero => self.finite_conflict(t.n[3] >> 2, vi, p),
+        let q = tt.v.map(|v| pts[v as usize]);
+        let r = xorshift(rng) as usize;
+        let mut moved = false;
+        for k in 0..4 {
+            let i = (r + k) & 3;
+            if i == from {
+                continue;
             }
-        } else {
-            self.finite_conflict(u, vi, p)
+            let l = TET_FACES[i];
+            if orient3d(q[l[0]], q[l[1]], q[l[2]], p) == Sign::Positive {
+                from = (tt.n[i] & 3) as usize;
+                t = tt.n[i] >> 2;
+                moved = true;
+                break;
+            }
         }
-    }
-
-    /// Grow the cavity of vertex `vi` from the conflicting tet `start`: fills `self.cavity` with
-    /// the conflicting tets (flagged) and `self.bnd` with the cavity's boundary faces.
-    #[inline(never)]
-    pub(crate) fn find_cavity(&mut self, vi: u32, p: [f64; 3], start: u32) {
-        self.cavity.clear();
-        self.bnd.clear();
-        self.tets[start as usize].v[0] |= FLAG;
-        self.cavity.push(start);
-        self.prefetch_neighbors(start);
-        // Breadth-first: the cavity list is the queue, which leaves time for the prefetches.
-        let mut next = 0;
-        while next < self.cavity.len() {
-            let t = self.cavity[next];
-            next += 1;
-            let tt = self.tets[t as usize];
-            for f in 0..4 {
-                let link = tt.n[f];
-                let u = link >> 2;
-                if self.tets[u as usize].v[0] & FLAG != 0 {
-                    continue;
-                }
-                if self.conflict(u, vi, p) {
-                    self.tets[u as usize].v[0] |= FLAG;
-                    self.cavity.push(u);
-                    self.prefetch_neighbors(u);
-                } else {
-                    let mut v = tt.v;
-                    v[0] &= !FLAG;
-                    v[f] = vi;
-                    self.bnd.push(Boundary {
-                        v,
-                        outer: link,
-                        f: f as u32,
-                    });
+        if !moved {
+            for k in 0..4 {
+                if q[k] == p {
+                    return Located::Duplicate(tt.v[k]);
                 }
             }
+            return Located::Conflict(t);
         }
     }
+}
 
-    /// Ask the memory system for the records of the four neighbours of `t`.
-    #[inline(always)]
-    fn prefetch_neighbors(&self, t: u32) {
-        #[cfg(target_arch = "x86_64")]
-        {
-            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-            let n = self.tets[t as usize].n;
-            for l in n {
-                let ptr = self.tets.as_ptr().wrapping_add((l >> 2) as usize);
-                // SAFETY: prefetching never faults, whatever the address.
-                unsafe { _mm_prefetch::<_MM_HINT_T0>(ptr.cast::<i8>()) };
+/// In-sphere conflict of the finite tet with vertices `v` (flag cleared) with vertex `vi` at
+/// `p`, decided with Simulation of Simplicity by public vertex number.
+#[inline(always)]
+fn finite_conflict(pts: &[[f64; 3]], ids: &[u32], v: [u32; 4], vi: u32, p: [f64; 3]) -> bool {
+    let q = v.map(|x| pts[x as usize]);
+    match insphere_filter(q[0], q[1], q[2], q[3], p) {
+        Some(s) => s == Sign::Positive,
+        None => finite_conflict_exact(pts, ids, v, vi, p),
+    }
+}
+
+#[inline(never)]
+fn finite_conflict_exact(pts: &[[f64; 3]], ids: &[u32], v: [u32; 4], vi: u32, p: [f64; 3]) -> bool {
+    let q = v.map(|x| pts[x as usize]);
+    let id = v.map(|x| ids[x as usize]);
+    insphere_sos_slow(
+        [q[0], q[1], q[2], q[3], p],
+        [id[0], id[1], id[2], id[3], ids[vi as usize]],
+    ) == Sign::Positive
+}
+
+/// Conflict of the live, unflagged tet `t` (record `r`) with vertex `vi` at `p`.
+///
+/// A ghost `(a, b, c, ∞)` conflicts when `p` is strictly on the outer side of its hull face;
+/// when `p` is on the face's plane it conflicts exactly when the finite tet across the hull
+/// face does: both are the perturbed in-circle test of `p` against the circle of `abc`, the
+/// limit of the in-sphere test of the ghost as its fourth vertex goes to infinity (see the
+/// module docs of [`super`]).
+#[inline(always)]
+fn conflict(tets: &[Tet], pts: &[[f64; 3]], ids: &[u32], r: &Tet, vi: u32, p: [f64; 3]) -> bool {
+    if r.v[3] == INF {
+        ghost_conflict(tets, pts, ids, r, vi, p)
+    } else {
+        finite_conflict(pts, ids, r.v, vi, p)
+    }
+}
+
+#[inline(never)]
+fn ghost_conflict(tets: &[Tet], pts: &[[f64; 3]], ids: &[u32], r: &Tet, vi: u32, p: [f64; 3]) -> bool {
+    let (a, b, c) = (
+        pts[r.v[0] as usize],
+        pts[r.v[2] as usize],
+        pts[r.v[1] as usize],
+    );
+    match orient3d(a, b, c, p) {
+        Sign::Negative => true,
+        Sign::Positive => false,
+        Sign::Zero => {
+            let mut v = tets[(r.n[3] >> 2) as usize].v;
+            v[0] &= !FLAG;
+            finite_conflict(pts, ids, v, vi, p)
+        }
+    }
+}
+
+/// Ask the memory system for the records of the four neighbours of `r`.
+#[inline(always)]
+fn prefetch_neighbors(tets: &[Tet], r: &Tet) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        for l in r.n {
+            let ptr = tets.as_ptr().wrapping_add((l >> 2) as usize);
+            // SAFETY: a prefetch never faults, whatever the address.
+            unsafe { _mm_prefetch::<_MM_HINT_T0>(ptr.cast::<i8>()) };
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (tets, r);
+}
+
+/// Grow the cavity of vertex `vi` at `p` from the conflicting tet `start`: fills `cavity` with
+/// the conflicting tets (flagged) and `bnd` with the cavity's boundary faces.
+#[allow(clippy::too_many_arguments)]
+fn find_cavity(
+    tets: &mut [Tet],
+    pts: &[[f64; 3]],
+    ids: &[u32],
+    vi: u32,
+    p: [f64; 3],
+    start: u32,
+    cavity: &mut Vec<u32>,
+    bnd: &mut Vec<Boundary>,
+) {
+    cavity.clear();
+    bnd.clear();
+    tets[start as usize].v[0] |= FLAG;
+    cavity.push(start);
+    prefetch_neighbors(tets, &tets[start as usize]);
+    // Breadth-first: the cavity list is the queue, which leaves time for the prefetches.
+    let mut next = 0;
+    while next < cavity.len() {
+        let t = cavity[next];
+        next += 1;
+        let tt = tets[t as usize];
+        for f in 0..4 {
+            let link = tt.n[f];
+            let u = (link >> 2) as usize;
+            let r = tets[u];
+            if r.v[0] & FLAG != 0 {
+                continue;
+            }
+            if conflict(tets, pts, ids, &r, vi, p) {
+                tets[u].v[0] |= FLAG;
+                cavity.push(u as u32);
+                prefetch_neighbors(tets, &r);
+            } else {
+                let mut v = tt.v;
+                v[0] &= !FLAG;
+                v[f] = vi;
+                bnd.push(Boundary {
+                    v,
+                    outer: link,
+                    f: f as u32,
+                });
             }
         }
     }
+}
 
+/// Pair the three faces of new tet `nt` (record being built in `n`, new vertex in slot `F`)
+/// around the new vertex with faces of the star built before, or leave them in the table for
+/// the faces built after.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn pair_faces<const F: usize>(
+    tets: &mut [Tet],
+    edges: &mut [EdgeSlot],
+    v: &[u32; 4],
+    nt: u32,
+    n: &mut [u32; 4],
+    stamp: u32,
+    shift: u32,
+    mask: usize,
+) {
+    for j in 0..4 {
+        if j == F {
+            continue;
+        }
+        let (ea, eb) = EDGE[F][j];
+        let (x, y) = (v[ea], v[eb]);
+        let key = u64::from(x) << 32 | u64::from(y);
+        let rev = u64::from(y) << 32 | u64::from(x);
+        let mut h = ((x.wrapping_add(y)).wrapping_mul(0x9E37_79B1) >> shift) as usize;
+        loop {
+            let e = &mut edges[h];
+            if e.stamp != stamp {
+                *e = EdgeSlot {
+                    key,
+                    link: nt << 2 | j as u32,
+                    stamp,
+                };
+                break;
+            }
+            if e.key == rev {
+                let other = e.link;
+                n[j] = other;
+                tets[(other >> 2) as usize].n[(other & 3) as usize] = nt << 2 | j as u32;
+                break;
+            }
+            h = (h + 1) & mask;
+        }
+    }
+}
+
+/// Build the star of new tets: `bnd[k]` goes to slot `slots[k]`. Faces around the new vertex are
+/// paired through `edges`, keyed by their directed cavity-boundary edge (entries of other stamps
+/// count as empty). Returns a new finite tet, or `NONE`.
+fn fill_star(
+    tets: &mut [Tet],
+    edges: &mut [EdgeSlot],
+    bnd: &[Boundary],
+    slots: &[u32],
+    stamp: u32,
+) -> u32 {
+    let mask = edges.len() - 1;
+    let shift = 32 - edges.len().trailing_zeros();
+    let mut last = NONE;
+    for (b, &nt) in bnd.iter().zip(slots) {
+        let f = b.f as usize;
+        let mut n = [0u32; 4];
+        n[f] = b.outer;
+        tets[(b.outer >> 2) as usize].n[(b.outer & 3) as usize] = nt << 2 | b.f;
+        if b.v[3] != INF {
+            last = nt;
+        }
+        match f {
+            0 => pair_faces::<0>(tets, edges, &b.v, nt, &mut n, stamp, shift, mask),
+            1 => pair_faces::<1>(tets, edges, &b.v, nt, &mut n, stamp, shift, mask),
+            2 => pair_faces::<2>(tets, edges, &b.v, nt, &mut n, stamp, shift, mask),
+            _ => pair_faces::<3>(tets, edges, &b.v, nt, &mut n, stamp, shift, mask),
+        }
+        // Faces paired later are written into this record by their partner.
+        tets[nt as usize] = Tet { v: b.v, n };
+    }
+    last
+}
+
+impl Delaunay {
     /// Undo the cavity marks (when the insertion is abandoned).
-    pub(crate) fn unflag_cavity(&mut self) {
+    fn unflag_cavity(&mut self) {
         for &t in &self.cavity {
             self.tets[t as usize].v[0] &= !FLAG;
         }
     }
 
-    /// Take a tet slot: the free list first, then a new one at the end.
-    #[inline]
-    fn alloc(&mut self) -> u32 {
-        if self.free != NONE {
-            let t = self.free;
-            self.free = self.tets[t as usize].n[0];
-            self.n_free -= 1;
-            t
-        } else {
-            let t = self.tets.len() as u32;
-            self.tets.push(Tet::default());
-            t
-        }
-    }
-
     /// Room for `extra` more tet slots without the doubling growth of `Vec` (which would waste
     /// up to half the largest array of the program): grow by an eighth at a time.
-    pub(crate) fn reserve_tets(&mut self, extra: usize) {
+    fn reserve_tets(&mut self, extra: usize) {
         let need = self.tets.len() + extra;
         if need > self.tets.capacity() {
             let grow = (self.tets.capacity() / 8).max(extra).max(1024);
@@ -306,70 +372,25 @@ impl Delaunay {
         }
     }
 
-    /// Replace the cavity by the star of new tets around `vi`. `self.cavity` and `self.bnd` come
-    /// from [`Delaunay::find_cavity`].
-    #[inline(never)]
-    pub(crate) fn fill_cavity(&mut self) {
+    /// Replace the cavity (`self.cavity`, `self.bnd`) by the star of new tets around the new
+    /// vertex: cavity slots are reused first, then the free list, then new slots.
+    fn fill_cavity(&mut self) {
         let nb = self.bnd.len();
         let nc = self.cavity.len();
-        if nb > nc {
-            self.reserve_tets(nb - nc);
+        self.slots.clear();
+        self.slots.extend_from_slice(&self.cavity[..nb.min(nc)]);
+        while self.slots.len() < nb && self.free != NONE {
+            let t = self.free;
+            self.free = self.tets[t as usize].n[0];
+            self.n_free -= 1;
+            self.slots.push(t);
         }
-        // Pairing table: load at most 1/2 (each boundary edge is stored once).
-        let need = (3 * nb).next_power_of_two().max(64);
-        if self.edges.len() < need {
-            self.edges.resize(need, EdgeSlot::default());
-        }
-        let mask = need - 1;
-        let shift = 32 - need.trailing_zeros();
-        self.stamp = self.stamp.wrapping_add(1);
-        if self.stamp == 0 {
-            self.edges.fill(EdgeSlot::default());
-            self.stamp = 1;
-        }
-        let stamp = self.stamp;
-        let mut last = NONE;
-        for k in 0..nb {
-            let b = self.bnd[k];
-            let nt = if k < nc { self.cavity[k] } else { self.alloc() };
-            let f = b.f as usize;
-            {
-                let t = &mut self.tets[nt as usize];
-                t.v = b.v;
-                t.n[f] = b.outer;
-            }
-            self.tets[(b.outer >> 2) as usize].n[(b.outer & 3) as usize] = nt << 2 | b.f;
-            if b.v[3] != INF {
-                last = nt;
-            }
-            for j in 0..4 {
-                if j == f {
-                    continue;
-                }
-                let (ea, eb) = EDGE[f][j];
-                let (x, y) = (b.v[ea], b.v[eb]);
-                let mut h = ((x.wrapping_add(y)).wrapping_mul(0x9E37_79B1) >> shift) as usize;
-                loop {
-                    let e = &mut self.edges[h];
-                    if e.stamp != stamp {
-                        *e = EdgeSlot {
-                            a: x,
-                            b: y,
-                            link: nt << 2 | j as u32,
-                            stamp,
-                        };
-                        break;
-                    }
-                    if e.a == y && e.b == x {
-                        let other = e.link;
-                        self.tets[nt as usize].n[j] = other;
-                        self.tets[(other >> 2) as usize].n[(other & 3) as usize] =
-                            nt << 2 | j as u32;
-                        break;
-                    }
-                    h = (h + 1) & mask;
-                }
-            }
+        if self.slots.len() < nb {
+            let extra = nb - self.slots.len();
+            self.reserve_tets(extra);
+            let first = self.tets.len() as u32;
+            self.tets.resize(self.tets.len() + extra, Tet::default());
+            self.slots.extend(first..first + extra as u32);
         }
         for k in nb..nc {
             let t = self.cavity[k];
@@ -379,20 +400,47 @@ impl Delaunay {
             self.free = t;
             self.n_free += 1;
         }
-        if last == NONE {
-            last = if nc > 0 { self.cavity[0] } else { self.last };
+        // Pairing table: load at most 1/4 (each boundary edge is stored once, 3·nb/2 of them).
+        let need = (6 * nb).next_power_of_two().max(128);
+        if self.edges.len() < need {
+            self.edges.resize(need, EdgeSlot::default());
         }
-        self.last = last;
+        self.stamp = self.stamp.wrapping_add(1);
+        if self.stamp == 0 {
+            self.edges.fill(EdgeSlot::default());
+            self.stamp = 1;
+        }
+        let last = fill_star(
+            &mut self.tets,
+            &mut self.edges[..need],
+            &self.bnd,
+            &self.slots,
+            self.stamp,
+        );
+        if last != NONE {
+            self.last = last;
+        } else if nb > 0 {
+            self.last = self.slots[0];
+        }
     }
 
     /// Insert the point with internal id `vi` (its coordinates are already in `pts`).
     pub(crate) fn insert_internal(&mut self, vi: u32) -> Inserted {
         let p = self.pts[vi as usize];
-        let start = match self.locate(p) {
+        let start = match locate(&self.tets, &self.pts, self.last, p, &mut self.walk_rng) {
             Located::Conflict(t) => t,
             Located::Duplicate(v) => return Inserted::Duplicate(v),
         };
-        self.find_cavity(vi, p, start);
+        find_cavity(
+            &mut self.tets,
+            &self.pts,
+            &self.ids,
+            vi,
+            p,
+            start,
+            &mut self.cavity,
+            &mut self.bnd,
+        );
         let (nb, nc) = (self.bnd.len(), self.cavity.len());
         if nb > nc + self.n_free && self.tets.len() + (nb - nc - self.n_free) > MAX_TETS {
             self.unflag_cavity();

@@ -136,7 +136,7 @@ pub struct Delaunay {
     stamp: u32,
     // Scratch buffers, reused by every insertion.
     cavity: Vec<u32>,
-    stack: Vec<u32>,
+    slots: Vec<u32>,
     bnd: Vec<Boundary>,
     edges: Vec<EdgeSlot>,
 }
@@ -223,7 +223,7 @@ impl Delaunay {
             walk_rng: 0x9E37_79B9,
             stamp: 0,
             cavity: Vec::new(),
-            stack: Vec::new(),
+            slots: Vec::new(),
             bnd: Vec::new(),
             edges: Vec::new(),
         };
@@ -527,7 +527,7 @@ impl Delaunay {
             + self.tets.capacity() * std::mem::size_of::<Tet>()
             + self.input_vertex.as_ref().map_or(0, |m| m.capacity() * 4)
             + self.cavity.capacity() * 4
-            + self.stack.capacity() * 4
+            + self.slots.capacity() * 4
             + self.bnd.capacity() * std::mem::size_of::<Boundary>()
             + self.edges.capacity() * std::mem::size_of::<EdgeSlot>()
     }

@@ -167,3 +167,80 @@ fn scaled_and_shifted_cube_stays_valid() {
         assert!(r.valid, "scale {s}: {r}");
     }
 }
+
+/// A positively oriented tet with corners `o + s·(unit tet corners)`.
+fn tet_at(o: [f64; 3], s: f64) -> Vec<[f64; 3]> {
+    vec![
+        o,
+        [o[0] + s, o[1], o[2]],
+        [o[0], o[1] + s, o[2]],
+        [o[0], o[1], o[2] + s],
+    ]
+}
+
+#[test]
+fn overlapping_tets_without_a_shared_face_are_invalid() {
+    // Every tet positive, no face shared at all: only the boundary shows the overlap.
+    let mut pts = tet_at([0.0; 3], 1.0);
+    pts.extend(tet_at([0.2, 0.2, 0.2], 1.0));
+    let m = TetMesh::new(pts, vec![[0, 1, 2, 3], [4, 5, 6, 7]], vec![1, 1]);
+    let r = check(&m, None);
+    assert_eq!(
+        r.n_nonpositive + r.n_overshared_faces + r.n_misoriented_faces,
+        0
+    );
+    assert!(!r.valid, "{r}");
+    assert!(
+        r.boundary_problem.as_deref().unwrap().contains("intersect"),
+        "{r}"
+    );
+}
+
+#[test]
+fn tet_nested_inside_another_is_invalid() {
+    // The small tet's boundary lies inside the big one's without crossing it: its shell is
+    // outward where a cavity would have to face inward.
+    let mut pts = tet_at([0.0; 3], 4.0);
+    pts.extend(tet_at([0.5, 0.5, 0.5], 1.0));
+    let m = TetMesh::new(pts, vec![[0, 1, 2, 3], [4, 5, 6, 7]], vec![1, 1]);
+    let r = check(&m, None);
+    assert!(!r.valid, "{r}");
+    assert!(r.boundary_problem.is_some(), "{r}");
+}
+
+#[test]
+fn separate_tets_are_valid() {
+    let mut pts = tet_at([0.0; 3], 1.0);
+    pts.extend(tet_at([3.0, 0.0, 0.0], 1.0));
+    let m = TetMesh::new(pts, vec![[0, 1, 2, 3], [4, 5, 6, 7]], vec![1, 1]);
+    let r = check(&m, None);
+    assert!(r.valid, "{r}");
+}
+
+#[test]
+fn empty_mesh_is_invalid() {
+    let r = check(&TetMesh::default(), None);
+    assert!(!r.valid);
+    assert!(r.problems.iter().any(|p| p.contains("no tets")));
+}
+
+#[test]
+fn wrong_labels_are_not_counted_as_extra_boundary_faces() {
+    // Two cubes labelled 1 and 2 checked against a surface that says both are region 1 with an
+    // interface [1, 2] where there is none in the surface: only labels disagree.
+    let m = two_cubes();
+    let mut s = cube_surface([0.0; 3], 1.0);
+    s.append(&cube_surface([1.0, 0.0, 0.0], 1.0));
+    // Keep only the outer triangles (drop the two copies of the shared face x = 1).
+    let keep: Vec<usize> = (0..s.triangles.len())
+        .filter(|&t| !s.corners(t).iter().all(|p| p[0] == 1.0))
+        .collect();
+    s.triangles = keep.iter().map(|&t| s.triangles[t]).collect();
+    s.sides = keep.iter().map(|_| [1, 0]).collect();
+    let r = check(&m, Some(&s));
+    let sc = r.surface.as_ref().unwrap();
+    assert!(!r.valid);
+    assert_eq!(sc.n_extra_boundary_faces, 0, "{r}");
+    // The right cube's 10 outer triangles have label 2 behind them, not 1.
+    assert_eq!(sc.n_label_mismatch, 10, "{r}");
+}
