@@ -1,12 +1,12 @@
 #!/usr/bin/env python3
 """Delaunay speed and memory: biotet beside TetGen, CGAL and Qhull, on the same points, in one run.
 
-    pip install numpy tetgen cgal scipy      # the anchors (each one is skipped if absent)
+    apt-get install tetgen; pip install numpy cgal scipy   # the anchors (each skipped if absent)
     cargo build --release -p biotet-cli
     python3 scripts/bench_delaunay.py --n 1000000 --repeat 3 [--lattice 100] [--json out.json]
 
 Each tool runs in its own process on the same point file; a row gives the median of the repeats
-of the triangulation time alone (TetGen's own "Delaunay seconds"; CGAL's insert; scipy's Delaunay;
+of the triangulation time alone (TetGen 1.5's binary, its own "Delaunay seconds"; CGAL's insert; scipy's Delaunay;
 biotet's `--json` seconds, without file I/O), points per second, finite tets, and the process's
 peak RSS (and its RSS before triangulating, so the difference is the triangulation's).
 """
@@ -26,22 +26,8 @@ CHILD = textwrap.dedent(r'''
                 if line.startswith("VmRSS"):
                     return int(line.split()[1])
     out = {}
-    if tool == "tetgen":
-        import tetgen
-        tg = tetgen.TetGen(p, np.array([[0, 1, 2]], dtype=np.int32))  # faces are ignored without -p
-        before = rss_kb()
-        r, w = os.pipe(); saved = os.dup(1); os.dup2(w, 1); os.close(w)
-        t = time.perf_counter()
-        res = tg.tetrahedralize(switches="V")
-        wall = time.perf_counter() - t
-        sys.stdout.flush(); os.dup2(saved, 1)
-        text = b""
-        while True:
-            chunk = os.read(r, 1 << 16)
-            if not chunk: break
-            text += chunk
-        m = re.search(rb"Delaunay seconds:\s*([0-9.]+)", text)
-        out = {"seconds": float(m.group(1)) if m else wall, "n_tets": int(res[1].shape[0])}
+    if False:
+        pass
     elif tool == "cgal":
         from CGAL.CGAL_Kernel import Point_3
         from CGAL.CGAL_Triangulation_3 import Delaunay_triangulation_3
@@ -68,6 +54,22 @@ def run_anchor(tool, npy):
     if r.returncode != 0:
         return {"error": (r.stderr.strip().splitlines() or ["failed"])[-1]}
     return json.loads(r.stdout.strip().splitlines()[-1])
+
+
+def run_tetgen(node):
+    """TetGen's own binary (Debian package `tetgen`); -NEF writes no output, -V prints timings."""
+    import re, shutil
+    exe = shutil.which("tetgen")
+    if not exe:
+        return {"error": "tetgen binary not found (apt-get install tetgen)"}
+    r = subprocess.run(["/usr/bin/time", "-f", "PEAK %M", exe, "-NEFV", node], capture_output=True, text=True)
+    if r.returncode != 0:
+        return {"error": r.stderr.strip()[-200:]}
+    sec = re.search(r"Delaunay seconds:\s*([0-9.e-]+)", r.stdout)
+    tets = re.search(r"Mesh tetrahedra:\s*(\d+)", r.stdout)
+    peak = re.search(r"PEAK (\d+)", r.stderr)
+    return {"seconds": float(sec.group(1)), "n_tets": int(tets.group(1)), "peak_rss_kb": int(peak.group(1)),
+            "rss_before_kb": None}
 
 
 def run_biotet(xyz):
@@ -102,10 +104,19 @@ def main():
     npy, xyz = os.path.join(d, "p.npy"), os.path.join(d, "p.xyz")
     np.save(npy, pts)
     np.savetxt(xyz, pts, fmt="%.17g")
+    node = os.path.join(d, "p.node")
+    with open(node, "w") as f:
+        f.write(f"{len(pts)} 3 0 0\n")
+        np.savetxt(f, np.column_stack([np.arange(1, len(pts) + 1), pts]), fmt=["%d", "%.17g", "%.17g", "%.17g"])
     rows = {}
     for rep in range(a.repeat):
         for tool in a.tools.split(","):
-            r = run_biotet(xyz) if tool == "biotet" else run_anchor(tool, npy)
+            if tool == "biotet":
+                r = run_biotet(xyz)
+            elif tool == "tetgen":
+                r = run_tetgen(node)
+            else:
+                r = run_anchor(tool, npy)
             rows.setdefault(tool, []).append(r)
     n = len(pts)
     print(f"# {name}, {a.repeat} runs each, median; machine: {os.cpu_count()} cores")

@@ -40,6 +40,8 @@ enum Command {
     Check(cmd::check::Args),
     /// Convert a mesh between formats (chosen by extension).
     Convert(cmd::convert::Args),
+    /// The 3D Delaunay tetrahedralization of a point cloud (exact, degenerate-proof).
+    Delaunay(cmd::delaunay::Args),
     /// Validate closed surfaces: closed, manifold, consistently oriented, no self-intersection.
     Validate(cmd::validate::Args),
 }
@@ -58,6 +60,7 @@ fn main() -> ExitCode {
         Command::Check(a) => cmd::check::run(a),
         Command::Convert(a) => cmd::convert::run(a),
         Command::Validate(a) => cmd::validate::run(a),
+        Command::Delaunay(a) => cmd::delaunay::run(a),
     };
     match result {
         Ok(code) => code,

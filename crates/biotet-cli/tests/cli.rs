@@ -424,3 +424,65 @@ fn quality_figures_of_a_cube_in_six_tets_through_the_cli() {
     assert_eq!(j["n_dihedral_lt_20"], 0);
     assert_eq!(j["n_dihedral_gt_160"], 0);
 }
+
+#[test]
+fn delaunay_of_a_lattice_is_valid_deterministic_and_reported() {
+    // A 12×12×12 integer lattice: massively cospherical, decided by the symbolic perturbation.
+    let dir = tempfile::tempdir().unwrap();
+    let pts = dir.path().join("lattice.xyz");
+    let mut text = String::from("# 12^3 lattice\n");
+    for i in 0..12 {
+        for j in 0..12 {
+            for k in 0..12 {
+                text += &format!("{i} {j} {k}\n");
+            }
+        }
+    }
+    std::fs::write(&pts, text).unwrap();
+    let a = dir.path().join("a.vtu");
+    let b = dir.path().join("b.vtu");
+    let j = json_of(&biotet(&["delaunay", s(&pts), "-o", s(&a), "--json"]));
+    for k in ["n_points", "n_tets", "seconds", "points_per_second"] {
+        assert!(j.get(k).is_some(), "missing {k}");
+    }
+    assert_eq!(j["n_points"], 1728);
+    assert!(j["seconds"].as_f64().unwrap() >= 0.0);
+    let out = biotet(&["delaunay", s(&pts), "-o", s(&b), "--quiet"]);
+    assert!(out.status.success());
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+    let c = json_of(&biotet(&["check", s(&a), "--json"]));
+    assert_eq!(c["valid"], true);
+    assert_eq!(c["n_points"], 1728);
+    assert_eq!(c["n_tets"], j["n_tets"]);
+    // The lattice's hull is the cube [0, 11]^3: volume 1331 (a float sum of 6655 tets).
+    let q = json_of(&biotet(&["quality", s(&a), "--json"]));
+    assert!((q["volume"].as_f64().unwrap() - 1331.0).abs() < 1e-6);
+}
+
+#[test]
+fn delaunay_refuses_bad_point_files() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, text, words) in [
+        ("short.xyz", "0 0 0\n1 0\n", &["short.xyz", "line 2"][..]),
+        (
+            "flat.xyz",
+            "0 0 0\n1 0 0\n0 1 0\n1 1 0\n",
+            &["flat.xyz", "coplanar"][..],
+        ),
+        (
+            "nan.xyz",
+            "0 0 0\n1 nan 0\n",
+            &["nan.xyz", "non-finite"][..],
+        ),
+    ] {
+        let p = dir.path().join(name);
+        std::fs::write(&p, text).unwrap();
+        let out = biotet(&["delaunay", s(&p), "-o", s(&dir.path().join("o.vtu"))]);
+        assert_eq!(out.status.code(), Some(2), "{name}");
+        let msg = stderr(&out);
+        for w in words {
+            assert!(msg.contains(w), "{name}: {msg}");
+        }
+        assert!(!dir.path().join("o.vtu").exists());
+    }
+}

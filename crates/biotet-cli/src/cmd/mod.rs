@@ -2,6 +2,7 @@
 
 pub mod check;
 pub mod convert;
+pub mod delaunay;
 pub mod input;
 pub mod quality;
 pub mod validate;

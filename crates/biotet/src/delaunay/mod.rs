@@ -5,7 +5,13 @@
 //! # Use
 //! ```
 //! use biotet::delaunay::Delaunay;
-//! let pts = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 1.0]];
+//! let pts = vec![
+//!     [0.0, 0.0, 0.0],
+//!     [1.0, 0.0, 0.0],
+//!     [0.0, 1.0, 0.0],
+//!     [0.0, 0.0, 1.0],
+//!     [1.0, 1.0, 1.0],
+//! ];
 //! let mut dt = Delaunay::new(&pts).unwrap();
 //! let v = dt.insert([0.25, 0.25, 0.25]).unwrap(); // vertex 5
 //! assert_eq!(v, 5);
@@ -24,11 +30,11 @@
 //! Degenerate configurations (five cospherical points, four coplanar points on the hull) have
 //! several Delaunay triangulations; the one built is the unique triangulation of the
 //! *perturbed* points of [`insphere_sos`](crate::geom::predicates::insphere_sos): point `i` is
-//! lifted to `|p_i|² + ε_i` with `ε_i` infinitesimal and growing with the vertex number. Equivalently,
-//! it is the regular triangulation of these lifted points, which are in general position as far
-//! as in-sphere tests go. It depends only on the point set and the vertex numbering, not on the
-//! insertion order: building from all points at once or from a part and inserting the rest gives
-//! the same tets.
+//! lifted to `|p_i|² + ε_i` with `ε_i` infinitesimal and growing with the vertex number.
+//! Equivalently, it is the regular triangulation of these lifted points, which are in general
+//! position as far as in-sphere tests go. It depends only on the point set and the vertex
+//! numbering, not on the insertion order: building from all points at once or from a part and
+//! inserting the rest gives the same tets.
 //!
 //! # The infinite vertex and coplanar hull points
 //! The triangulation is closed by one infinite vertex: each hull face `abc` carries a ghost tet
@@ -54,23 +60,36 @@
 //!
 //! # Algorithm and performance
 //! - Insertion order: exact duplicates removed, then BRIO rounds (sizes doubling, a fixed-seed
-//!   SplitMix64 RNG) with a Hilbert curve order inside each round. The points are copied in that
-//!   order, so neighbours in space are neighbours in memory.
+//!   SplitMix64 RNG) with a Hilbert curve order inside each round (one radix sort of 30-bit
+//!   Hilbert keys). The points are copied in that order, so neighbours in space are neighbours in
+//!   memory.
 //! - Location: a remembering stochastic visibility walk from the last tet created.
-//! - Cavity: a depth-first search over conflicting tets; the new tets reuse the cavity's slots,
-//!   then a free list; their faces around the new vertex are paired through a small open-addressing
-//!   table keyed by the directed cavity-boundary edge (stamped entries, never cleared).
-//! - Predicates: semi-static float filters ([`crate::geom::filter`]) in front of the exact
-//!   adaptive predicates and `insphere_sos`.
-//! - Storage: 32 bytes per tet (4 vertices + 4 links `tet << 2 | face`), 24 bytes per point plus
-//!   4 bytes for its vertex number; buffers are reused, nothing is allocated per insertion.
+//! - Cavity: a breadth-first search over conflicting tets (the cavity list is the queue; the
+//!   neighbours of each new cavity tet are prefetched). Marks are a bit in the tet record, set on
+//!   cavity tets only, and disappear when the slot is reused or freed: nothing is ever cleared.
+//! - New tets: `[p, boundary face]`, in the cavity's slots first, then a free list (linked
+//!   through the dead records), then new slots. Their faces around `p` are paired with no search:
+//!   boundary vertices get local numbers (one byte per vertex), and a 64×64 table of directed
+//!   local edges gives each face its partner (a stamped hash table takes over for cavities with
+//!   more than about 60 boundary vertices).
+//! - Predicates: semi-static float filters in front of the exact adaptive predicates and the
+//!   perturbation, plus exact `f64` evaluation for points on a common binary grid (lattices), see
+//!   [`crate::geom::filter`]. The hot kernels are compiled twice, for the baseline target and for
+//!   x86-64-v4 (AVX-512; the filter then uses fused multiply-adds), chosen at run time; both give
+//!   the same triangulation.
+//! - Storage: 32 bytes per tet (4 vertices + 4 links `tet << 2 | face`; about 6.75 tets per
+//!   random point), 24 bytes per point plus 4 for its vertex number and 1 of scratch; the tet
+//!   array grows by an eighth at a time (untouched capacity costs no memory). Buffers are reused:
+//!   nothing is allocated per insertion.
+//! - Limits: fewer than 2³¹ − 1 points and 2³⁰ tet slots ([`DelaunayError::TooLarge`]).
 
 mod kernel;
 mod order;
 
+use crate::geom::filter::Grid;
 use crate::geom::predicates::{Sign, orient2d, orient3d};
 use crate::mesh::tet::{NO_NEIGHBOR, TET_FACES, TetMesh};
-use kernel::{Boundary, EdgeSlot, FLAG, INF, Inserted, MAX_TETS, NONE, Tet};
+use kernel::{Boundary, FLAG, INF, Inserted, Isa, LOCAL, MAX_TETS, NONE, StarScratch, Tet};
 use thiserror::Error;
 
 /// The vertex number standing for the infinite vertex in [`Delaunay::tet`] (slot 3 of ghosts).
@@ -85,6 +104,12 @@ pub enum DelaunayError {
     /// A coordinate is NaN or infinite.
     #[error("point {index} has a non-finite coordinate")]
     NonFinite {
+        /// Index of the offending point in the input.
+        index: usize,
+    },
+    /// A coordinate is larger than [`MAX_COORDINATE`] in magnitude.
+    #[error("point {index} has a coordinate beyond ±1e50, where exact arithmetic could overflow")]
+    OutOfRange {
         /// Index of the offending point in the input.
         index: usize,
     },
@@ -130,15 +155,17 @@ pub struct Delaunay {
     n_inputs: usize,
     /// Input index -> vertex number; `None` while it is the identity.
     input_vertex: Option<Vec<u32>>,
+    /// Grid certificate of all points (exact fast predicates on lattices).
+    grid: Grid,
     /// Walk RNG state (xorshift32).
     walk_rng: u32,
-    /// Edge-pairing table stamp.
-    stamp: u32,
+    /// Instruction set of the hot kernels.
+    isa: Isa,
     // Scratch buffers, reused by every insertion.
     cavity: Vec<u32>,
     slots: Vec<u32>,
     bnd: Vec<Boundary>,
-    edges: Vec<EdgeSlot>,
+    star: StarScratch,
 }
 
 /// True when `a`, `b`, `c` lie on one line (exact: all three axis projections are degenerate).
@@ -151,24 +178,72 @@ fn collinear(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> bool {
         && orient2d(zx(a), zx(b), zx(c)) == Sign::Zero
 }
 
-fn check_finite(points: &[[f64; 3]], offset: usize) -> Result<(), DelaunayError> {
-    match points.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
-        Some(i) => Err(DelaunayError::NonFinite { index: offset + i }),
-        None => Ok(()),
+/// Reorder `v` so that `v[k]` becomes the old `v[perm[k]]`; `perm` is a permutation of
+/// `0..v.len()`. Follows the cycles with a bit per element.
+fn permute_in_place<T: Copy>(v: &mut [T], perm: &[u32]) {
+    debug_assert_eq!(v.len(), perm.len());
+    let mut done = vec![0u64; v.len().div_ceil(64)];
+    for start in 0..v.len() {
+        if done[start / 64] >> (start % 64) & 1 == 1 {
+            continue;
+        }
+        let first = v[start];
+        let mut k = start;
+        loop {
+            done[k / 64] |= 1 << (k % 64);
+            let src = perm[k] as usize;
+            if src == start {
+                v[k] = first;
+                break;
+            }
+            v[k] = v[src];
+            k = src;
+        }
     }
+}
+
+/// Largest coordinate magnitude accepted: beyond it the exact predicates (products of up to
+/// five coordinate differences, and their expansions) could overflow.
+pub const MAX_COORDINATE: f64 = 1e50;
+
+/// Every coordinate finite and at most [`MAX_COORDINATE`] in magnitude.
+fn check_finite(points: &[[f64; 3]], offset: usize) -> Result<(), DelaunayError> {
+    for (i, p) in points.iter().enumerate() {
+        if !p.iter().all(|c| c.is_finite()) {
+            return Err(DelaunayError::NonFinite { index: offset + i });
+        }
+        if !p.iter().all(|c| c.abs() <= MAX_COORDINATE) {
+            return Err(DelaunayError::OutOfRange { index: offset + i });
+        }
+    }
+    Ok(())
 }
 
 impl Delaunay {
     /// The Delaunay tetrahedralization of `points`.
     ///
-    /// Exact duplicates are merged (see [`Delaunay::vertex_map`]). Fails on non-finite
-    /// coordinates, on fewer than 4 distinct points and on collinear or coplanar input.
+    /// Exact duplicates are merged (see [`Delaunay::vertex_map`]). Fails on non-finite or
+    /// too large coordinates (beyond [`MAX_COORDINATE`]), on fewer than 4 distinct points and on
+    /// collinear or coplanar input.
     pub fn new(points: &[[f64; 3]]) -> Result<Delaunay, DelaunayError> {
-        check_finite(points, 0)?;
-        if points.len() >= INF as usize {
+        Delaunay::new_with_isa(points.to_vec(), Isa::detect())
+    }
+
+    /// [`Delaunay::new`] taking the points by value: they are reordered in place and kept as the
+    /// triangulation's own copy, which saves 24 bytes per point at the peak.
+    pub fn from_points(points: Vec<[f64; 3]>) -> Result<Delaunay, DelaunayError> {
+        Delaunay::new_with_isa(points, Isa::detect())
+    }
+
+    /// [`Delaunay::from_points`] with the kernels of a given instruction set.
+    fn new_with_isa(mut points: Vec<[f64; 3]>, isa: Isa) -> Result<Delaunay, DelaunayError> {
+        check_finite(&points, 0)?;
+        let n = points.len();
+        if n >= INF as usize {
             return Err(DelaunayError::TooLarge);
         }
-        let order = order::insertion_order(points, SEED);
+        let grid = Grid::of(&points);
+        let order = order::insertion_order(&points, SEED);
         let mut seq = order.seq;
         let m = seq.len();
         if m < 4 {
@@ -183,14 +258,13 @@ impl Delaunay {
         else {
             return Err(DelaunayError::Coplanar);
         };
-        let (s2, s3) = (seq[k2], seq[k3]);
-        seq.remove(k3);
-        seq.remove(k2);
-        seq.insert(2, s2);
-        seq.insert(3, s3);
+        // [s0, s1, .., s2 (at k2), .., s3 (at k3), ..] -> [s0, s1, s2, s3, the rest in order].
+        seq[2..=k3].rotate_right(1);
+        seq[3..=k2 + 1].rotate_right(1);
+        seq.swap(2, 3);
 
         // Vertex numbers: input order with duplicates removed.
-        let input_vertex = order.rep.map(|rep| {
+        let input_vertex = order.rep.as_ref().map(|rep| {
             let mut map = vec![0u32; rep.len()];
             let mut c = 0u32;
             for i in 0..rep.len() {
@@ -203,12 +277,23 @@ impl Delaunay {
             }
             map
         });
+        // The points in insertion order, in place: complete `seq` into a permutation of all
+        // inputs (duplicates last) and follow its cycles.
+        if let Some(rep) = &order.rep {
+            seq.extend((0..n as u32).filter(|&i| rep[i as usize] != i));
+        }
+        permute_in_place(&mut points, &seq);
+        points.truncate(m);
+        if m < n {
+            points.shrink_to_fit();
+        }
+        seq.truncate(m);
         let ids: Vec<u32> = match &input_vertex {
-            None => seq.clone(),
+            // Without duplicates the vertex number is the input index.
+            None => seq,
             Some(map) => seq.iter().map(|&i| map[i as usize]).collect(),
         };
-        let pts: Vec<[f64; 3]> = seq.iter().map(|&i| points[i as usize]).collect();
-        drop(seq);
+        let pts = points;
 
         let mut dt = Delaunay {
             pts,
@@ -218,14 +303,18 @@ impl Delaunay {
             n_free: 0,
             last: 0,
             n_vertices: m,
-            n_inputs: points.len(),
+            n_inputs: n,
             input_vertex,
+            grid,
             walk_rng: 0x9E37_79B9,
-            stamp: 0,
+            isa,
             cavity: Vec::new(),
             slots: Vec::new(),
             bnd: Vec::new(),
-            edges: Vec::new(),
+            star: StarScratch {
+                map: vec![0; LOCAL * LOCAL],
+                ..StarScratch::default()
+            },
         };
         // About 6.7 tets per point for random points; untouched capacity costs no memory.
         dt.tets.reserve_exact(m / 8 * 55 + 64);
@@ -286,6 +375,7 @@ impl Delaunay {
         }
         let vi = self.pts.len() as u32;
         let number = self.n_vertices as u32;
+        self.grid = self.grid.with(p);
         self.pts.push(p);
         self.ids.push(number);
         let v = match self.insert_internal(vi) {
@@ -323,23 +413,30 @@ impl Delaunay {
     /// Insert a batch of points (in BRIO + Hilbert order, which is much faster than one by one
     /// in a random order); returns the vertex number of each. New vertices are numbered in the
     /// order of `points`, duplicates (within the batch or of existing vertices) removed, exactly
-    /// as if the points had been inserted one by one with [`Delaunay::insert`]. On error nothing
-    /// after the first failing point is inserted.
+    /// as if the points had been inserted one by one with [`Delaunay::insert`], and the
+    /// triangulation is the same too.
+    ///
+    /// On [`DelaunayError::TooLarge`] the triangulation stays valid and holds part of the batch,
+    /// which is not recorded as input (the vertex map does not grow).
     pub fn insert_points(&mut self, points: &[[f64; 3]]) -> Result<Vec<u32>, DelaunayError> {
         check_finite(points, self.n_inputs)?;
         if self.pts.len() + points.len() >= INF as usize {
             return Err(DelaunayError::TooLarge);
         }
         let base = self.n_vertices as u32;
-        let order = order::batch_order(points, SEED ^ self.n_inputs as u64);
+        for p in points {
+            self.grid = self.grid.with(*p);
+        }
+        // Duplicates inside the batch are removed first (the first occurrence stays), so that
+        // every new vertex is created by its first occurrence.
+        let order = order::insertion_order(points, SEED ^ self.n_inputs as u64);
         // Provisional numbers base + batch index: their order is the final order, so the
         // perturbation (which only compares numbers) is already the final one. Numbers of points
-        // that turn out to be duplicates are squeezed out afterwards.
+        // that turn out to be duplicates of existing vertices are squeezed out afterwards.
         let mut internal = vec![NONE; points.len()];
-        let mut result = vec![0u32; points.len()];
         let mut is_new = vec![false; points.len()];
         let mut failed = false;
-        for &i in &order {
+        for &i in &order.seq {
             let vi = self.pts.len() as u32;
             self.pts.push(points[i as usize]);
             self.ids.push(base + i);
@@ -362,30 +459,23 @@ impl Delaunay {
             }
         }
         // Final numbers of the new vertices: base + rank among new ones in batch order.
-        let mut rank = vec![NONE; points.len()];
         let mut c = base;
         for i in 0..points.len() {
             if is_new[i] {
-                rank[i] = c;
+                self.ids[internal[i] as usize] = c;
                 c += 1;
             }
         }
-        for i in 0..points.len() {
-            if is_new[i] {
-                self.ids[internal[i] as usize] = rank[i];
-            }
-        }
         self.n_vertices = c as usize;
-        for i in 0..points.len() {
-            if internal[i] == NONE {
-                break;
-            }
-            result[i] = self.ids[internal[i] as usize];
-        }
         if failed {
-            // Only a prefix in batch order is recorded as input; everything inserted stays.
             return Err(DelaunayError::TooLarge);
         }
+        let result: Vec<u32> = (0..points.len())
+            .map(|i| {
+                let r = order.rep.as_ref().map_or(i, |r| r[i] as usize);
+                self.ids[internal[r] as usize]
+            })
+            .collect();
         for &v in &result {
             self.push_input(v);
         }
@@ -529,8 +619,115 @@ impl Delaunay {
             + self.cavity.capacity() * 4
             + self.slots.capacity() * 4
             + self.bnd.capacity() * std::mem::size_of::<Boundary>()
-            + self.edges.capacity() * std::mem::size_of::<EdgeSlot>()
+            + self.star.local.capacity()
+            + self.star.lids.capacity() * 3
+            + self.star.map.capacity() * 4
+            + self.star.edges.capacity() * 16
     }
 }
 
 const _: () = assert!(MAX_TETS <= 1 << 30);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::check::check;
+
+    /// The fallback pairing of the star's faces (hash table), used for cavities with more than
+    /// 60 boundary vertices, forced on every insertion: the same triangulation.
+    #[test]
+    fn hashed_face_pairing_gives_the_same_triangulation() {
+        let mut pts = Vec::new();
+        for z in 0..6 {
+            for y in 0..5 {
+                for x in 0..7 {
+                    pts.push([f64::from(x), f64::from(y), f64::from(z)]);
+                }
+            }
+        }
+        let mut seed = 3u64;
+        for _ in 0..300 {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            pts.push([(seed >> 11) as f64 / (1u64 << 53) as f64 * 6.0, 2.5, 3.0]);
+        }
+        let fast = Delaunay::new(&pts).unwrap().to_tet_mesh();
+        let mut dt = Delaunay::new(&pts[..40]).unwrap();
+        dt.star.force_hash = true;
+        dt.insert_points(&pts[40..]).unwrap();
+        let slow = dt.to_tet_mesh();
+        assert!(check(&slow, None).valid);
+        let key = |m: &TetMesh| {
+            let mut t: Vec<[u32; 4]> = m
+                .tets
+                .iter()
+                .map(|t| {
+                    let mut s = *t;
+                    s.sort_unstable();
+                    s
+                })
+                .collect();
+            t.sort_unstable();
+            t
+        };
+        assert_eq!(key(&fast), key(&slow));
+    }
+
+    /// The baseline kernels and the ones compiled for this CPU give the same triangulation.
+    #[test]
+    fn instruction_sets_agree() {
+        let mut seed = 9u64;
+        let mut next = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut pts: Vec<[f64; 3]> = (0..3000).map(|_| [next(), next(), next()]).collect();
+        for i in 0..1000 {
+            pts.push([
+                f64::from(i % 10),
+                f64::from(i / 10 % 10),
+                f64::from(i / 100),
+            ]);
+        }
+        let a = Delaunay::new_with_isa(pts.clone(), Isa::Baseline)
+            .unwrap()
+            .to_tet_mesh();
+        let b = Delaunay::new_with_isa(pts.clone(), Isa::detect())
+            .unwrap()
+            .to_tet_mesh();
+        assert!(check(&a, None).valid);
+        assert_eq!(a, b);
+    }
+
+    /// Cavities with more than 60 boundary vertices take the fallback on their own: the centre
+    /// of 1032 cospherical lattice points, inserted last, sees every tet.
+    #[test]
+    fn huge_cavity() {
+        let r2 = 2966;
+        let mut pts = Vec::new();
+        for x in -55i32..=55 {
+            for y in -55i32..=55 {
+                let z2 = r2 - x * x - y * y;
+                if z2 >= 0 {
+                    let z = f64::from(z2).sqrt() as i32;
+                    if z * z == z2 {
+                        pts.push([f64::from(x), f64::from(y), f64::from(z)]);
+                        if z != 0 {
+                            pts.push([f64::from(x), f64::from(y), -f64::from(z)]);
+                        }
+                    }
+                }
+            }
+        }
+        assert_eq!(pts.len(), 1032);
+        let mut dt = Delaunay::new(&pts).unwrap();
+        dt.insert([0.0; 3]).unwrap();
+        let mesh = dt.to_tet_mesh();
+        assert!(check(&mesh, None).valid);
+        // Every hull face is now a tet with the centre.
+        assert_eq!(mesh.n_tets(), dt.n_hull_faces());
+    }
+}

@@ -3,8 +3,8 @@
 //! All points are sorted once along a 3D Hilbert curve (keys on a 2¹⁰ grid per axis over the
 //! bounding cube). Exact duplicates share a grid cell, so a sort of each run of equal keys by
 //! coordinates puts them side by side. The distinct points are then dealt into BRIO rounds (each
-//! point goes to round k with probability ~ (1 − r)·rᵏ counted from the last round) by a fixed-seed
-//! RNG, and a stable counting sort by round keeps the Hilbert order inside each round.
+//! point goes to round k with probability ~ (1 − r)·rᵏ counted from the last round) by a
+//! fixed-seed RNG, and a stable counting sort by round keeps the Hilbert order inside each round.
 
 /// SplitMix64: a tiny, fast, deterministic generator (no `rand` dependency needed).
 #[derive(Debug, Clone)]
@@ -247,13 +247,6 @@ pub(crate) fn brio(sorted: Vec<u32>, seed: u64) -> Vec<u32> {
         start[l] += 1;
     }
     out
-}
-
-/// Hilbert + BRIO order of a batch of points given by index (used for batch insertion into an
-/// existing triangulation; duplicates are handled by the insertion itself).
-pub(crate) fn batch_order(points: &[[f64; 3]], seed: u64) -> Vec<u32> {
-    let keys = hilbert_sort(points, 0..points.len() as u32);
-    brio(keys.iter().map(|&k| k as u32).collect(), seed)
 }
 
 #[cfg(test)]

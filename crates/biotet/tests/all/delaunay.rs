@@ -136,7 +136,11 @@ fn validate(points: &[[f64; 3]], dt: &Delaunay) -> TetMesh {
                 [c[0], c[1], c[2], c[3], mesh.points[opp as usize]],
                 [tv[0], tv[1], tv[2], tv[3], opp],
             );
-            assert_eq!(s, Sign::Negative, "face {i} of tet {t} {tv:?} is not locally Delaunay");
+            assert_eq!(
+                s,
+                Sign::Negative,
+                "face {i} of tet {t} {tv:?} is not locally Delaunay"
+            );
             // And symmetrically from the other side.
             let c = mesh.corners(u as usize);
             let s = insphere_sos(
@@ -148,7 +152,10 @@ fn validate(points: &[[f64; 3]], dt: &Delaunay) -> TetMesh {
     }
 
     // The hull is convex: every point on the inner side of every hull face or on its plane.
-    let hull: Vec<[u32; 3]> = mesh.boundary_faces().map(|(t, f)| mesh.face(t, f)).collect();
+    let hull: Vec<[u32; 3]> = mesh
+        .boundary_faces()
+        .map(|(t, f)| mesh.face(t, f))
+        .collect();
     for f in &hull {
         let [a, b, c] = f.map(|v| mesh.points[v as usize]);
         for q in &mesh.points {
@@ -202,7 +209,7 @@ fn validate(points: &[[f64; 3]], dt: &Delaunay) -> TetMesh {
             continue;
         }
         let tv = dt.tet(t);
-        assert_eq!(tv[..3].contains(&INFINITE), false);
+        assert!(!tv[..3].contains(&INFINITE));
         for (i, u) in dt.adjacent(t).into_iter().enumerate() {
             let (back, j) = dt.adjacent_face(t, i);
             assert_eq!(back, u);
@@ -229,9 +236,10 @@ fn brute_force(points: &[[f64; 3]]) -> Vec<[u32; 4]> {
                         Sign::Positive => {}
                     }
                     let empty = (0..n).filter(|e| !v.contains(e)).all(|e| {
-                        filter::insphere_sos([q(v[0]), q(v[1]), q(v[2]), q(v[3]), q(e)], [
-                            v[0], v[1], v[2], v[3], e,
-                        ]) == Sign::Negative
+                        filter::insphere_sos(
+                            [q(v[0]), q(v[1]), q(v[2]), q(v[3]), q(e)],
+                            [v[0], v[1], v[2], v[3], e],
+                        ) == Sign::Negative
                     });
                     if empty {
                         out.push([a, b, c, d]);
@@ -271,7 +279,10 @@ fn uniform_random_points() {
     let pts = random_points(10_000, 1);
     let mesh = build_and_validate(&pts);
     let per_point = mesh.n_tets() as f64 / pts.len() as f64;
-    assert!((5.5..7.0).contains(&per_point), "{per_point} tets per point");
+    assert!(
+        (5.5..7.0).contains(&per_point),
+        "{per_point} tets per point"
+    );
 }
 
 #[test]
@@ -331,6 +342,38 @@ fn points_on_a_few_planes() {
     let pts: Vec<[f64; 3]> = lattice(10, 10, 2)
         .into_iter()
         .map(|p| [p[0], p[1], p[2] * 5.0])
+        .collect();
+    build_and_validate(&pts);
+}
+
+#[test]
+fn nearly_degenerate_float_inputs() {
+    // Points computed in floating point on a sphere, on tilted planes and on a lattice with a
+    // spacing that is not a binary fraction: almost cospherical and coplanar, so the filters
+    // fail and the exact predicates decide.
+    let mut r = Rng(13);
+    let mut pts = Vec::new();
+    for _ in 0..1500 {
+        let (u, v) = (r.unit() * std::f64::consts::TAU, r.unit() * 2.0 - 1.0);
+        let w = (1.0 - v * v).sqrt();
+        pts.push([0.3 + w * u.cos(), -0.2 + w * u.sin(), 0.1 + v]);
+    }
+    build_and_validate(&pts);
+    let mut pts = Vec::new();
+    let n = [0.36, -0.48, 0.8];
+    for k in 0..4 {
+        for _ in 0..300 {
+            let (a, b) = (r.unit() * 4.0 - 2.0, r.unit() * 4.0 - 2.0);
+            // Two directions in the plane orthogonal to n, offset along n.
+            let (e1, e2) = ([0.8, 0.6, 0.0], [-0.48, 0.64, 0.6]);
+            let o = f64::from(k) * 0.7;
+            pts.push([0, 1, 2].map(|i| a * e1[i] + b * e2[i] + o * n[i]));
+        }
+    }
+    build_and_validate(&pts);
+    let pts: Vec<[f64; 3]> = lattice(9, 8, 7)
+        .into_iter()
+        .map(|p| p.map(|c| 0.1 * c + 0.05))
         .collect();
     build_and_validate(&pts);
 }
@@ -439,6 +482,39 @@ fn incremental_insertion_gives_the_same_triangulation() {
 }
 
 #[test]
+fn batch_insertion_with_duplicates() {
+    // A batch repeating its own points and points already in the triangulation: numbering by
+    // first occurrence, and the same triangulation as one build over everything.
+    let mut r = Rng(12);
+    let first: Vec<[f64; 3]> = lattice(4, 4, 4);
+    let mut batch = Vec::new();
+    for _ in 0..400 {
+        let p = [
+            r.below(7) as f64 - 1.0,
+            r.below(6) as f64,
+            r.below(5) as f64 - 0.5,
+        ];
+        batch.push(p);
+        if r.below(4) == 0 {
+            batch.push(first[r.below(64) as usize]);
+        }
+    }
+    let mut dt = Delaunay::new(&first).unwrap();
+    let vs = dt.insert_points(&batch).unwrap();
+    let mut all = first.clone();
+    all.extend_from_slice(&batch);
+    assert_eq!(vs, dt.vertex_map()[first.len()..].to_vec());
+    let mesh = validate(&all, &dt);
+    assert_eq!(sorted_tets(&mesh), sorted_tets(&build_and_validate(&all)));
+    // And inserted one by one.
+    let mut dt = Delaunay::new(&first).unwrap();
+    for p in &batch {
+        dt.insert(*p).unwrap();
+    }
+    assert_eq!(sorted_tets(&validate(&all, &dt)), sorted_tets(&mesh));
+}
+
+#[test]
 fn insertion_outside_and_on_the_hull() {
     // Start from a small block and insert points outside it, on its hull planes and duplicates.
     let mut pts = lattice(3, 3, 3);
@@ -455,6 +531,29 @@ fn insertion_outside_and_on_the_hull() {
     }
     let mesh = validate(&pts, &dt);
     assert_eq!(sorted_tets(&mesh), sorted_tets(&build_and_validate(&pts)));
+}
+
+#[test]
+fn nearly_all_collinear_or_coplanar() {
+    // The first tet needs points found deep in the insertion order.
+    let mut pts: Vec<[f64; 3]> = (0..500).map(|i| [f64::from(i), 0.0, 0.0]).collect();
+    pts.push([3.5, 2.0, 0.0]);
+    pts.push([7.0, 1.0, -4.0]);
+    build_and_validate(&pts);
+    let mut pts: Vec<[f64; 3]> = lattice(30, 30, 1);
+    pts.insert(417, [3.0, 4.0, 1.0]);
+    build_and_validate(&pts);
+}
+
+#[test]
+fn from_points_is_new() {
+    let mut pts = random_points(2000, 14);
+    pts.extend_from_within(..300);
+    let a = Delaunay::new(&pts).unwrap();
+    let b = Delaunay::from_points(pts.clone()).unwrap();
+    assert_eq!(a.to_tet_mesh(), b.to_tet_mesh());
+    assert_eq!(a.vertex_map(), b.vertex_map());
+    validate(&pts, &b);
 }
 
 #[test]
@@ -484,6 +583,12 @@ fn degenerate_inputs_are_errors() {
     assert_eq!(
         Delaunay::new(&nan).unwrap_err(),
         DelaunayError::NonFinite { index: 4 }
+    );
+    let mut huge = random_points(10, 2);
+    huge[7][2] = -1e200;
+    assert_eq!(
+        Delaunay::new(&huge).unwrap_err(),
+        DelaunayError::OutOfRange { index: 7 }
     );
     assert!(Delaunay::new(&[]).is_err());
     // Exactly four points: one tet.
@@ -524,7 +629,11 @@ fn qhull_through_scipy_agrees() {
         stdin.write_all(text.as_bytes()).expect("write points");
     }
     let out = child.wait_with_output().expect("python3 finishes");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let mut qhull: Vec<[u32; 4]> = String::from_utf8_lossy(&out.stdout)
         .lines()
         .map(|l| {
