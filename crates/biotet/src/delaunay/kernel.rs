@@ -20,7 +20,8 @@
 
 use super::Delaunay;
 use crate::geom::filter::{
-    Grid, insphere_filter_fma_on, insphere_filter_on, insphere_sos_slow, orient3d_on,
+    Grid, insphere_certified, insphere_decide, insphere_det, insphere_det_fma, insphere_sos_slow,
+    orient3d_on,
 };
 use crate::geom::predicates::Sign;
 use crate::mesh::tet::TET_FACES;
@@ -223,12 +224,22 @@ fn finite_conflict(k: &Kernel, v: [u32; 4]) -> bool {
             pt(k.pts, v[3]),
         )
     };
-    let s = if k.fma {
-        insphere_filter_fma_on(a, b, c, d, k.p, k.grid)
+    let [det, m] = if k.fma {
+        insphere_det_fma(a, b, c, d, k.p)
     } else {
-        insphere_filter_on(a, b, c, d, k.p, k.grid)
+        insphere_det(a, b, c, d, k.p)
     };
-    match s {
+    // The usual case: a certified sign, returned as data (no branch on it: conflicts are
+    // unpredictable, and the cavity search consumes the answer without branching).
+    if insphere_certified(det, m) {
+        return det < 0.0;
+    }
+    finite_conflict_uncertain(k, v, det, m)
+}
+
+#[inline(never)]
+fn finite_conflict_uncertain(k: &Kernel, v: [u32; 4], det: f64, m: f64) -> bool {
+    match insphere_decide(det, m, k.grid) {
         Some(Sign::Positive) => true,
         Some(Sign::Negative) => false,
         // Exactly cospherical (certified by the grid): the perturbation decides.
@@ -397,21 +408,30 @@ fn visit_face<const F: usize>(
     if r.v[0] & FLAG != 0 {
         return;
     }
-    if conflict(tets, k, &r) {
-        unsafe { rec_mut(tets, u) }.v[0] |= FLAG;
-        cavity.push(u);
-        prefetch_neighbors(tets, &r);
-    } else {
-        let l = FACE_ROT[F];
-        let v = [tt.v[l[0]], tt.v[l[1]], tt.v[l[2]]];
+    // Both outcomes are written, and the lengths advanced by the answer: no unpredictable
+    // branch. (Every vertex of a cavity tet is on the cavity boundary, so resetting the local
+    // numbers of the face's vertices is right either way.)
+    let hit = conflict(tets, k, &r);
+    let l = FACE_ROT[F];
+    let v = [tt.v[l[0]], tt.v[l[1]], tt.v[l[2]]];
+    cavity.reserve(1);
+    bnd.reserve(1);
+    // SAFETY: `u` is live; one free element was reserved in each list; finite vertex ids
+    // index `local` (sized like `pts`).
+    unsafe {
+        rec_mut(tets, u).v[0] |= FLAG * u32::from(hit);
+        let (nc, nb) = (cavity.len(), bnd.len());
+        cavity.as_mut_ptr().add(nc).write(u);
+        cavity.set_len(nc + usize::from(hit));
+        bnd.as_mut_ptr().add(nb).write(Boundary { v, outer: link });
+        bnd.set_len(nb + usize::from(!hit));
         for x in v {
             if x != INF {
-                // SAFETY: finite vertex ids index `local` (sized like `pts`).
-                unsafe { *local.get_unchecked_mut(x as usize) = u8::MAX };
+                *local.get_unchecked_mut(x as usize) = u8::MAX;
             }
         }
-        bnd.push(Boundary { v, outer: link });
     }
+    prefetch_neighbors(tets, &r);
 }
 
 /// `tets[t].n[i] = link`, unchecked in release builds.

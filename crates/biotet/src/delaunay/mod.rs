@@ -59,13 +59,17 @@
 //! triangulation for any input.
 //!
 //! # Algorithm and performance
-//! - Insertion order: exact duplicates removed, then BRIO rounds (sizes doubling, a fixed-seed
-//!   SplitMix64 RNG) with a Hilbert curve order inside each round (one radix sort of 30-bit
+//! - Insertion order: exact duplicates removed, then BRIO rounds (sizes growing eightfold, as in
+//!   CGAL: fewer rounds and a long final round in Hilbert order, about 6% faster than doubling;
+//!   a fixed-seed SplitMix64 RNG) with a Hilbert curve order inside each round (one radix sort of 30-bit
 //!   Hilbert keys). The points are copied in that order, so neighbours in space are neighbours in
 //!   memory.
 //! - Location: a remembering stochastic visibility walk from the last tet created.
 //! - Cavity: a breadth-first search over conflicting tets (the cavity list is the queue; the
-//!   neighbours of each new cavity tet are prefetched). Marks are a bit in the tet record, set on
+//!   neighbours of each new cavity tet are prefetched). The in-sphere answer is used as data, not
+//!   branched on: each visited neighbour is written both to the cavity and to the boundary list,
+//!   and the answer advances one of the two lengths (conflicts are unpredictable; this saves
+//!   about 15% of the build). Marks are a bit in the tet record, set on
 //!   cavity tets only, and disappear when the slot is reused or freed: nothing is ever cleared.
 //! - New tets: `[p, boundary face]`, in the cavity's slots first, then a free list (linked
 //!   through the dead records), then new slots. Their faces around `p` are paired with no search:

@@ -243,6 +243,23 @@ pub fn insphere_filter_on(
     grid: Grid,
 ) -> Option<Sign> {
     let [det, m] = insphere_det(a, b, c, d, e);
+    insphere_decide(det, m, grid)
+}
+
+/// Whether the first-stage determinant `det` with largest lift `m` (of [`insphere_det`] or
+/// [`insphere_det_fma`]) certifies a nonzero sign without any grid: then the sign of
+/// [`insphere_filter_on`] is that of `-det`. No branch on the sign itself, so callers can use
+/// `det < 0` as data.
+#[inline(always)]
+pub fn insphere_certified(det: f64, m: f64) -> bool {
+    // |error| < INS_BOUND · m^2.5 (see the module docs); compared squared, without a root.
+    (INS_LO..=INS_HI).contains(&m) & (det * det > INS_BOUND2 * ((m * m) * (m * m) * m))
+}
+
+/// The sign [`insphere_filter_on`] certifies from the first-stage determinant `det` and the
+/// largest lift `m` of [`insphere_det`] (or `det` of [`insphere_det_fma`]).
+#[inline(always)]
+pub fn insphere_decide(det: f64, m: f64, grid: Grid) -> Option<Sign> {
     // |error| < INS_BOUND · m^2.5 (see the module docs); compared squared, without a root.
     if (INS_LO..=INS_HI).contains(&m) {
         let eb2 = INS_BOUND2 * ((m * m) * (m * m) * m);
@@ -274,6 +291,20 @@ pub fn insphere_filter_fma_on(
     e: [f64; 3],
     grid: Grid,
 ) -> Option<Sign> {
+    let [det, m] = insphere_det_fma(a, b, c, d, e);
+    insphere_decide(det, m, grid)
+}
+
+/// [`insphere_det`] with fused multiply-adds (see [`insphere_filter_fma_on`]: only call it from
+/// code compiled with the `fma` target feature). The same bound holds for its `det`.
+#[inline(always)]
+pub fn insphere_det_fma(
+    a: [f64; 3],
+    b: [f64; 3],
+    c: [f64; 3],
+    d: [f64; 3],
+    e: [f64; 3],
+) -> [f64; 2] {
     let aex = a[0] - e[0];
     let bex = b[0] - e[0];
     let cex = c[0] - e[0];
@@ -306,20 +337,7 @@ pub fn insphere_filter_fma_on(
 
     let det = dlift.mul_add(abc, -(clift * dab)) + blift.mul_add(cda, -(alift * bcd));
     let m = mx(mx(alift, blift), mx(clift, dlift));
-    if (INS_LO..=INS_HI).contains(&m) {
-        let eb2 = INS_BOUND2 * ((m * m) * (m * m) * m);
-        if det * det > eb2 {
-            return Some(if det > 0.0 {
-                Sign::Negative
-            } else {
-                Sign::Positive
-            });
-        }
-    }
-    if m < grid.ins2 {
-        return Some(Sign::of(det).flip());
-    }
-    None
+    [det, m]
 }
 
 /// Shewchuk's first-stage insphere determinant of `abcd` and `e` (positive when `e` is inside
@@ -329,7 +347,7 @@ pub fn insphere_filter_fma_on(
 /// a wide out-of-order core, which already runs the scalar formula's independent operations in
 /// parallel.)
 #[inline(always)]
-fn insphere_det(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3], e: [f64; 3]) -> [f64; 2] {
+pub fn insphere_det(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3], e: [f64; 3]) -> [f64; 2] {
     let aex = a[0] - e[0];
     let bex = b[0] - e[0];
     let cex = c[0] - e[0];
