@@ -111,8 +111,12 @@ pub enum DelaunayError {
         /// Index of the offending point in the input.
         index: usize,
     },
-    /// A coordinate is larger than [`MAX_COORDINATE`] in magnitude.
-    #[error("point {index} has a coordinate beyond ±1e50, where exact arithmetic could overflow")]
+    /// A coordinate is larger than [`MAX_COORDINATE`] in magnitude, or non-zero and smaller
+    /// than [`MIN_COORDINATE`]: exact arithmetic could overflow or underflow there.
+    #[error(
+        "point {index} has a coordinate outside the exact range (0, or magnitude between \
+         7.9e-31 and 1e50, where exact arithmetic neither underflows nor overflows): rescale the input"
+    )]
     OutOfRange {
         /// Index of the offending point in the input.
         index: usize,
@@ -206,17 +210,20 @@ fn permute_in_place<T: Copy>(v: &mut [T], perm: &[u32]) {
     }
 }
 
-/// Largest coordinate magnitude accepted: beyond it the exact predicates (products of up to
-/// five coordinate differences, and their expansions) could overflow.
-pub const MAX_COORDINATE: f64 = 1e50;
+// The accepted coordinate range is the predicates' exact range.
+pub use crate::geom::predicates::{MAX_COORDINATE, MIN_COORDINATE};
 
-/// Every coordinate finite and at most [`MAX_COORDINATE`] in magnitude.
+/// Every coordinate finite and in the exact range of the predicates (0, or a magnitude between
+/// [`MIN_COORDINATE`] and [`MAX_COORDINATE`]).
 fn check_finite(points: &[[f64; 3]], offset: usize) -> Result<(), DelaunayError> {
     for (i, p) in points.iter().enumerate() {
         if !p.iter().all(|c| c.is_finite()) {
             return Err(DelaunayError::NonFinite { index: offset + i });
         }
-        if !p.iter().all(|c| c.abs() <= MAX_COORDINATE) {
+        if !p
+            .iter()
+            .all(|&c| crate::geom::predicates::in_exact_range(c))
+        {
             return Err(DelaunayError::OutOfRange { index: offset + i });
         }
     }

@@ -17,6 +17,23 @@
 
 use robust::{Coord, Coord3D};
 
+/// Largest coordinate magnitude for which the predicates stay exact: the degree-5 products of
+/// in-sphere cannot overflow.
+pub const MAX_COORDINATE: f64 = 1e50;
+
+/// Smallest non-zero coordinate magnitude for which the predicates stay exact, 2⁻¹⁰⁰ (about
+/// 7.9e-31): every coordinate difference is then a multiple of 2⁻¹⁵², so the degree-5 products of
+/// the exact stages are multiples of 2⁻⁷⁶⁰ and never underflow (the adaptive predicates are exact
+/// only without underflow).
+pub const MIN_COORDINATE: f64 = 7.888_609_052_210_118e-31;
+
+/// True when `c` is 0 or its magnitude lies in [[`MIN_COORDINATE`], [`MAX_COORDINATE`]]: the range
+/// in which every predicate of this module is exact.
+#[inline]
+pub fn in_exact_range(c: f64) -> bool {
+    c == 0.0 || (MIN_COORDINATE..=MAX_COORDINATE).contains(&c.abs())
+}
+
 /// The sign of a determinant.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Sign {

@@ -674,3 +674,46 @@ fn face_table_consistency() {
         assert_eq!(f, g);
     }
 }
+
+/// Scaling by a power of two is exact, so the triangulation must not change — down to the
+/// smallest scale the predicates are exact at, and up to the largest.
+#[test]
+fn power_of_two_scales_give_the_same_tets_and_out_of_range_is_refused() {
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1);
+        // In [0.001, 1): far from zero, so scaled coordinates stay in range.
+        0.001 + 0.999 * ((state >> 11) as f64 / (1u64 << 53) as f64)
+    };
+    let pts: Vec<[f64; 3]> = (0..1500).map(|_| [next(), next(), next()]).collect();
+    let reference = biotet::delaunay::Delaunay::new(&pts).unwrap().to_tet_mesh();
+    for k in [-80, -40, 40, 150] {
+        let s = 2f64.powi(k);
+        let scaled: Vec<[f64; 3]> = pts.iter().map(|p| p.map(|c| c * s)).collect();
+        let m = biotet::delaunay::Delaunay::new(&scaled)
+            .unwrap()
+            .to_tet_mesh();
+        assert_eq!(m.tets, reference.tets, "scale 2^{k}");
+        assert!(biotet::check::check(&m, None).valid, "scale 2^{k}");
+    }
+    // Below the exact range (differences would underflow) and above it: a clear error.
+    for s in [2f64.powi(-250), 1e-80, 1e60] {
+        let scaled: Vec<[f64; 3]> = pts.iter().map(|p| p.map(|c| c * s)).collect();
+        let e = biotet::delaunay::Delaunay::new(&scaled).unwrap_err();
+        assert!(
+            matches!(e, biotet::delaunay::DelaunayError::OutOfRange { .. }),
+            "scale {s}: {e}"
+        );
+    }
+    // A unit tet with a cluster of tiny points: refused, not silently meshed wrong.
+    let mut cluster = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+    ];
+    cluster.push([1e-80, 2e-80, 3e-80]);
+    assert!(biotet::delaunay::Delaunay::new(&cluster).is_err());
+}
