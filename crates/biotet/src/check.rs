@@ -4,7 +4,7 @@
 //! Every decision is exact: orientation by [`orient3d`], surface matching by exact coordinates.
 //! Every test that makes a mesh runs this on it; `biotet check` prints its report.
 
-use crate::geom::predicates::{Sign, orient3d};
+use crate::geom::predicates::{Sign, in_exact_range, orient3d};
 use crate::mesh::surface::SurfaceMesh;
 use crate::mesh::tet::{NO_NEIGHBOR, TET_FACES, TetMesh, sorted3};
 use crate::mesh::validate::{ValidateOptions, validate_surface};
@@ -40,7 +40,8 @@ pub struct CheckReport {
     pub n_unused_points: usize,
     /// Points with exactly the same coordinates as an earlier point.
     pub n_duplicate_points: usize,
-    /// Non-finite coordinates.
+    /// Non-finite coordinates, or coordinates outside the exact range of the predicates (0 or a
+    /// magnitude between 2⁻¹⁰⁰ and 1e50), where no sign could be trusted.
     pub n_nonfinite_points: usize,
     /// Label array length differs from the tet count (0 or 1).
     pub n_label_errors: usize,
@@ -139,10 +140,10 @@ pub fn check(mesh: &TetMesh, surface: Option<&SurfaceMesh>) -> CheckReport {
         ));
     }
     for (i, p) in mesh.points.iter().enumerate() {
-        if !p.iter().all(|c| c.is_finite()) {
+        if !p.iter().all(|&c| in_exact_range(c)) {
             r.n_nonfinite_points += 1;
             r.note(r.n_nonfinite_points, || {
-                format!("point {i} is not finite: {p:?}")
+                format!("point {i} is not finite or outside the exact range: {p:?}")
             });
         }
     }

@@ -5,7 +5,7 @@
 //! first few (lowest indices first) with triangle indices and coordinates:
 //!
 //! 1. sizes and indices: no triangles, `sides` of the wrong length, point indices out of range
-//!    ([`SurfaceError::IndexOutOfRange`]), non-finite coordinates ([`SurfaceError::NonFinite`]),
+//!    ([`SurfaceError::IndexOutOfRange`]), non-finite or out-of-range coordinates ([`SurfaceError::NonFinite`]),
 //!    the same region on both sides of a triangle ([`SurfaceError::SameRegionBothSides`]);
 //! 2. degenerate triangles: a repeated vertex or collinear corners, decided exactly
 //!    ([`SurfaceError::Degenerate`]);
@@ -478,8 +478,14 @@ pub enum SurfaceError {
         /// Triangle index and its point indices.
         first: Vec<(u32, [u32; 3])>,
     },
-    /// Points with NaN or infinite coordinates.
-    #[error("non-finite coordinates: {}; first: {}", plural(*.count, "point"), point_list(.first))]
+    /// Points with NaN, infinite, or out-of-range coordinates (outside the exact range of the
+    /// predicates, [`crate::geom::predicates::in_exact_range`]).
+    #[error(
+        "non-finite or out-of-range coordinates (exact predicates need 0 or a magnitude between \
+         7.9e-31 and 1e50): {}; first: {}",
+        plural(*.count, "point"),
+        point_list(.first)
+    )]
     NonFinite {
         /// Number of offending points.
         count: usize,
@@ -741,7 +747,11 @@ pub fn validate_surface(
     }
     let bad: Vec<u32> = (0..np as u32)
         .into_par_iter()
-        .filter(|&i| s.points[i as usize].iter().any(|c| !c.is_finite()))
+        .filter(|&i| {
+            s.points[i as usize]
+                .iter()
+                .any(|&c| !crate::geom::predicates::in_exact_range(c))
+        })
         .collect();
     if !bad.is_empty() {
         return Err(SurfaceError::NonFinite {

@@ -244,3 +244,16 @@ fn wrong_labels_are_not_counted_as_extra_boundary_faces() {
     // The right cube's 10 outer triangles have label 2 behind them, not 1.
     assert_eq!(sc.n_label_mismatch, 10, "{r}");
 }
+
+#[test]
+fn coordinates_outside_the_exact_range_are_reported() {
+    // At 1e-200 the orientation determinants underflow: no sign can be trusted, so the checker
+    // says so instead of reporting wrong orientations.
+    let mut m = cube6();
+    for p in &mut m.points {
+        *p = p.map(|c| c * 1e-200);
+    }
+    let r = check(&m, None);
+    assert!(!r.valid);
+    assert_eq!(r.n_nonfinite_points, 7, "{r}"); // every corner but the origin
+}
