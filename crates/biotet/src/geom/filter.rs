@@ -561,23 +561,7 @@ pub fn insphere_sos_slow(p: [[f64; 3]; 5], ids: [u32; 5], grid: Grid) -> Sign {
 /// `p`: the first non-zero cofactor of the lifted coordinates, largest id first.
 #[inline(never)]
 pub fn sos_cofactors(p: [[f64; 3]; 5], ids: [u32; 5], grid: Grid) -> Sign {
-    let mut order = [0usize, 1, 2, 3, 4];
-    order.sort_unstable_by(|&i, &j| ids[j].cmp(&ids[i]));
-    for &k in &order {
-        let mut rest = [[0.0; 3]; 4];
-        let mut n = 0;
-        for (i, q) in p.iter().enumerate() {
-            if i != k {
-                rest[n] = *q;
-                n += 1;
-            }
-        }
-        let o = orient3d_on(rest[0], rest[1], rest[2], rest[3], grid);
-        if o != Sign::Zero {
-            return o.times(k % 2 == 1);
-        }
-    }
-    Sign::Zero
+    super::predicates::insphere_sos_cofactors(p, ids, |a, b, c, d| orient3d_on(a, b, c, d, grid))
 }
 
 #[cfg(test)]

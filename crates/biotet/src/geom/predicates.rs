@@ -138,6 +138,20 @@ pub fn insphere_sos(p: [[f64; 3]; 5], ids: [u32; 5]) -> Sign {
     if s != Sign::Zero {
         return s;
     }
+    insphere_sos_cofactors(p, ids, orient3d)
+}
+
+/// The perturbation part of [`insphere_sos`] for five exactly cospherical points: the sign of
+/// the first non-zero cofactor of the lifted coordinates, taking points from the largest id down;
+/// the cofactor of slot `k` is `(-1)^(k+1) · orient(other four, in order)`. `orient` must be an
+/// exact orient3d (the plain one, or a filtered one that falls back to it). The one definition of
+/// the tie-break rule, shared by every caller so that all of them perturb alike.
+#[inline]
+pub fn insphere_sos_cofactors(
+    p: [[f64; 3]; 5],
+    ids: [u32; 5],
+    orient: impl Fn([f64; 3], [f64; 3], [f64; 3], [f64; 3]) -> Sign,
+) -> Sign {
     let mut order = [0usize, 1, 2, 3, 4];
     order.sort_unstable_by(|&i, &j| ids[j].cmp(&ids[i]));
     for &k in &order {
@@ -149,7 +163,7 @@ pub fn insphere_sos(p: [[f64; 3]; 5], ids: [u32; 5]) -> Sign {
                 n += 1;
             }
         }
-        let o = orient3d(rest[0], rest[1], rest[2], rest[3]);
+        let o = orient(rest[0], rest[1], rest[2], rest[3]);
         if o != Sign::Zero {
             return o.times(k % 2 == 1);
         }
