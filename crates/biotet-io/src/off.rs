@@ -15,7 +15,7 @@ use biotet::SurfaceMesh;
 use crate::SurfaceRead;
 use crate::common::{check_surface, read_all};
 use crate::error::{Error, Result};
-use crate::text::{Lexer, Out, reserve_cap, show};
+use crate::text::{Lexer, Out, reserve_cap, show, write_points_and_counted_triangles};
 
 /// Read an OFF surface from a stream; `file` names it in errors.
 pub fn read<R: std::io::Read>(r: R, file: &str) -> Result<SurfaceRead> {
@@ -139,24 +139,5 @@ pub fn write<W: Write>(w: W, mesh: &SurfaceMesh, file: &str) -> Result<()> {
     out.c(b' ');
     out.int(mesh.triangles.len());
     out.s(" 0\n");
-    for p in &mesh.points {
-        out.f64(p[0]);
-        out.c(b' ');
-        out.f64(p[1]);
-        out.c(b' ');
-        out.f64(p[2]);
-        out.c(b'\n');
-        out.check().map_err(|e| Error::io(file, e))?;
-    }
-    for t in &mesh.triangles {
-        out.c(b'3');
-        for &v in t {
-            out.c(b' ');
-            out.int(v);
-        }
-        out.c(b'\n');
-        out.check().map_err(|e| Error::io(file, e))?;
-    }
-    out.finish().map_err(|e| Error::io(file, e))?;
-    Ok(())
+    write_points_and_counted_triangles(out, mesh, file)
 }

@@ -17,7 +17,7 @@ use biotet::SurfaceMesh;
 use crate::SurfaceRead;
 use crate::common::{check_surface, read_all};
 use crate::error::{Error, Result};
-use crate::text::{Lexer, Out, reserve_cap, show};
+use crate::text::{Lexer, Out, reserve_cap, show, write_points_and_counted_triangles};
 
 /// Read a PLY surface from a stream; `file` names it in errors.
 pub fn read<R: std::io::Read>(r: R, file: &str) -> Result<SurfaceRead> {
@@ -441,24 +441,5 @@ pub fn write_ascii<W: Write>(w: W, mesh: &SurfaceMesh, file: &str) -> Result<()>
     check_surface(mesh, file)?;
     let mut out = Out::new(w);
     header(&mut out, "ascii", mesh);
-    for p in &mesh.points {
-        out.f64(p[0]);
-        out.c(b' ');
-        out.f64(p[1]);
-        out.c(b' ');
-        out.f64(p[2]);
-        out.c(b'\n');
-        out.check().map_err(|e| Error::io(file, e))?;
-    }
-    for t in &mesh.triangles {
-        out.c(b'3');
-        for &v in t {
-            out.c(b' ');
-            out.int(v);
-        }
-        out.c(b'\n');
-        out.check().map_err(|e| Error::io(file, e))?;
-    }
-    out.finish().map_err(|e| Error::io(file, e))?;
-    Ok(())
+    write_points_and_counted_triangles(out, mesh, file)
 }

@@ -347,3 +347,32 @@ impl<W: Write> Out<W> {
         Ok(self.w)
     }
 }
+
+/// The body shared by OFF and ASCII PLY: one `x y z` line per point, then one `3 a b c` line per
+/// triangle; finishes the output.
+pub(crate) fn write_points_and_counted_triangles<W: Write>(
+    mut out: Out<W>,
+    mesh: &biotet::SurfaceMesh,
+    file: &str,
+) -> Result<()> {
+    for p in &mesh.points {
+        out.f64(p[0]);
+        out.c(b' ');
+        out.f64(p[1]);
+        out.c(b' ');
+        out.f64(p[2]);
+        out.c(b'\n');
+        out.check().map_err(|e| Error::io(file, e))?;
+    }
+    for t in &mesh.triangles {
+        out.c(b'3');
+        for &v in t {
+            out.c(b' ');
+            out.int(v);
+        }
+        out.c(b'\n');
+        out.check().map_err(|e| Error::io(file, e))?;
+    }
+    out.finish().map_err(|e| Error::io(file, e))?;
+    Ok(())
+}
