@@ -42,6 +42,10 @@ enum Command {
     Convert(cmd::convert::Args),
     /// The 3D Delaunay tetrahedralization of a point cloud (exact, degenerate-proof).
     Delaunay(cmd::delaunay::Args),
+    /// Mesh the volume inside a closed surface: template node deployment, Delaunay, outside
+    /// removal (and the later stages as they land). Without a surface, meshes the bundled
+    /// brain example.
+    Mesh(cmd::mesh::Args),
     /// Validate closed surfaces: closed, manifold, consistently oriented, no self-intersection.
     Validate(cmd::validate::Args),
 }
@@ -61,6 +65,7 @@ fn main() -> ExitCode {
         Command::Convert(a) => cmd::convert::run(a),
         Command::Validate(a) => cmd::validate::run(a),
         Command::Delaunay(a) => cmd::delaunay::run(a),
+        Command::Mesh(a) => cmd::mesh::run(a),
     };
     match result {
         Ok(code) => code,

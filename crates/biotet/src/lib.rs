@@ -12,7 +12,10 @@ pub mod check;
 pub mod delaunay;
 pub mod geom;
 pub mod mesh;
+pub mod pipeline;
 pub mod quality;
+pub mod sizing;
+pub mod template;
 
 pub use mesh::surface::SurfaceMesh;
 pub use mesh::tet::{NO_NEIGHBOR, TET_FACES, TetMesh};

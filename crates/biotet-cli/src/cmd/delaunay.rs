@@ -22,7 +22,7 @@ pub struct Args {
 }
 
 /// Peak and current resident memory of this process in KiB (Linux; `None` elsewhere).
-fn memory_kb() -> (Option<u64>, Option<u64>) {
+pub fn memory_kb() -> (Option<u64>, Option<u64>) {
     let Ok(status) = std::fs::read_to_string("/proc/self/status") else {
         return (None, None);
     };

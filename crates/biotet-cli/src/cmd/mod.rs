@@ -4,5 +4,6 @@ pub mod check;
 pub mod convert;
 pub mod delaunay;
 pub mod input;
+pub mod mesh;
 pub mod quality;
 pub mod validate;

@@ -528,6 +528,22 @@ impl Delaunay {
         out
     }
 
+    /// The coordinates of every vertex by vertex number, consuming the triangulation: the
+    /// points are reordered in place, so no second copy is made.
+    pub fn into_vertex_points(self) -> Vec<[f64; 3]> {
+        if self.pts.len() != self.n_vertices {
+            return self.vertex_points();
+        }
+        let mut inv = vec![0u32; self.n_vertices];
+        for (i, &v) in self.ids.iter().enumerate() {
+            inv[v as usize] = i as u32;
+        }
+        let Delaunay { mut pts, tets, .. } = self;
+        drop(tets);
+        permute_in_place(&mut pts, &inv);
+        pts
+    }
+
     /// Number of tet slots; tet ids are `0..n_slots()`.
     pub fn n_slots(&self) -> usize {
         self.tets.len()
@@ -559,6 +575,11 @@ impl Delaunay {
                 self.ids[v as usize]
             }
         })
+    }
+
+    /// The corner coordinates of finite tet `t`, in the order of [`tet`](Self::tet).
+    pub fn tet_points(&self, t: u32) -> [[f64; 3]; 4] {
+        self.tets[t as usize].v.map(|v| self.pts[v as usize])
     }
 
     /// The tets across the four faces of tet `t` (face `i` is opposite vertex `i`, see

@@ -57,6 +57,15 @@ impl TetMesh {
         self.points.len()
     }
 
+    /// Bytes of the mesh's arrays (lengths, not capacities): 24 per point, 36 per tet.
+    pub fn bytes(&self) -> usize {
+        use std::mem::size_of_val;
+        size_of_val(&self.points[..])
+            + size_of_val(&self.tets[..])
+            + size_of_val(&self.neighbors[..])
+            + size_of_val(&self.labels[..])
+    }
+
     /// The four corner coordinates of tet `t`.
     #[inline]
     pub fn corners(&self, t: usize) -> [[f64; 3]; 4] {

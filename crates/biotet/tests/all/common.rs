@@ -99,3 +99,143 @@ pub fn two_cubes() -> TetMesh {
     let labels = [vec![1; 6], vec![2; 6]].concat();
     TetMesh::new(pts, tets, labels)
 }
+
+/// Read a binary STL from `tests/data` of the repository (welded by exact coordinates), as one
+/// closed region.
+pub fn load_stl(name: &str) -> SurfaceMesh {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../tests/data/");
+    let data = std::fs::read(format!("{path}{name}")).expect("test data");
+    let n = u32::from_le_bytes(data[80..84].try_into().unwrap()) as usize;
+    let mut points = Vec::with_capacity(3 * n);
+    let mut tris = Vec::with_capacity(n);
+    for t in 0..n {
+        let rec = &data[84 + 50 * t..84 + 50 * (t + 1)];
+        let mut tri = [0u32; 3];
+        for (k, v) in tri.iter_mut().enumerate() {
+            let f = |a: usize| {
+                let o = 12 + 12 * k + 4 * a;
+                f32::from_le_bytes(rec[o..o + 4].try_into().unwrap()) as f64
+            };
+            *v = points.len() as u32;
+            points.push([f(0), f(1), f(2)]);
+        }
+        tris.push(tri);
+    }
+    let mut s = SurfaceMesh::closed(points, tris, 1);
+    s.weld_exact();
+    s
+}
+
+/// The octahedron |x| + |y| + |z| = r, outward, sides [1, 0].
+pub fn octahedron(r: f64) -> SurfaceMesh {
+    let p = vec![
+        [r, 0.0, 0.0],
+        [-r, 0.0, 0.0],
+        [0.0, r, 0.0],
+        [0.0, -r, 0.0],
+        [0.0, 0.0, r],
+        [0.0, 0.0, -r],
+    ];
+    let t = vec![
+        [0, 2, 4],
+        [2, 1, 4],
+        [1, 3, 4],
+        [3, 0, 4],
+        [2, 0, 5],
+        [1, 2, 5],
+        [3, 1, 5],
+        [0, 3, 5],
+    ];
+    SurfaceMesh::closed(p, t, 1)
+}
+
+/// An icosphere of radius `r` centred at the origin, `levels` times subdivided, outward.
+pub fn icosphere(r: f64, levels: usize) -> SurfaceMesh {
+    let g = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut p: Vec<[f64; 3]> = vec![
+        [-1.0, g, 0.0],
+        [1.0, g, 0.0],
+        [-1.0, -g, 0.0],
+        [1.0, -g, 0.0],
+        [0.0, -1.0, g],
+        [0.0, 1.0, g],
+        [0.0, -1.0, -g],
+        [0.0, 1.0, -g],
+        [g, 0.0, -1.0],
+        [g, 0.0, 1.0],
+        [-g, 0.0, -1.0],
+        [-g, 0.0, 1.0],
+    ];
+    let mut t: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..levels {
+        let mut mid = std::collections::HashMap::new();
+        let mut next = Vec::new();
+        for tri in &t {
+            let mut m = [0u32; 3];
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                let key = (a.min(b), a.max(b));
+                m[k] = *mid.entry(key).or_insert_with(|| {
+                    let (pa, pb) = (p[a as usize], p[b as usize]);
+                    p.push([0, 1, 2].map(|i| (pa[i] + pb[i]) / 2.0));
+                    (p.len() - 1) as u32
+                });
+            }
+            next.push([tri[0], m[0], m[2]]);
+            next.push([tri[1], m[1], m[0]]);
+            next.push([tri[2], m[2], m[1]]);
+            next.push(m);
+        }
+        t = next;
+    }
+    for q in &mut p {
+        let l = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt();
+        *q = q.map(|c| c * r / l);
+    }
+    SurfaceMesh::closed(p, t, 1)
+}
+
+/// Distance from `p` to the triangle `t` (float; for measuring, not deciding).
+pub fn point_triangle_distance(p: [f64; 3], t: [[f64; 3]; 3]) -> f64 {
+    use biotet::geom::vec3::{add, cross, dot, norm, scale, sub};
+    let n = cross(sub(t[1], t[0]), sub(t[2], t[0]));
+    let nn = dot(n, n);
+    // Projection inside the triangle: the plane distance.
+    let q = sub(p, scale(n, dot(sub(p, t[0]), n) / nn));
+    let inside = (0..3).all(|k| {
+        let (a, b) = (t[k], t[(k + 1) % 3]);
+        dot(cross(sub(b, a), sub(q, a)), n) >= 0.0
+    });
+    if inside {
+        return norm(sub(p, q));
+    }
+    (0..3)
+        .map(|k| {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            let ab = sub(b, a);
+            let s = (dot(sub(p, a), ab) / dot(ab, ab)).clamp(0.0, 1.0);
+            norm(sub(p, add(a, scale(ab, s))))
+        })
+        .fold(f64::INFINITY, f64::min)
+}

@@ -1,0 +1,266 @@
+//! Surface to volume mesh: deploy nodes ([`crate::template`]), tetrahedralize them
+//! ([`crate::delaunay`]), keep the tets inside the surface, then the later stages. This module
+//! only strings the stages together, times them and counts what they did.
+
+use std::time::Instant;
+
+use rustc_hash::{FxHashMap, FxHashSet};
+use serde::Serialize;
+
+use crate::delaunay::{Delaunay, DelaunayError};
+use crate::mesh::inside::{Location, RegionLocator, Transitions};
+use crate::mesh::surface::SurfaceMesh;
+use crate::mesh::tet::{NO_NEIGHBOR, TetMesh};
+use crate::sizing::Sizing;
+use crate::template::{DeployError, DeployOptions, TemplateStats, deploy};
+
+/// Options of [`mesh_surface`].
+#[derive(Debug, Clone, Default)]
+pub struct PipelineOptions {
+    /// Node deployment.
+    pub deploy: DeployOptions,
+}
+
+/// Time and outcome of one stage.
+#[derive(Debug, Clone, Serialize)]
+pub struct StageReport {
+    /// Stage name.
+    pub name: &'static str,
+    /// Wall seconds.
+    pub seconds: f64,
+}
+
+/// What the pipeline did.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct MeshReport {
+    /// Stages in order with their times.
+    pub stages: Vec<StageReport>,
+    /// Seconds from start to finish (excluding reading and writing files).
+    pub seconds_total: f64,
+    /// Template figures.
+    pub template: TemplateStats,
+    /// Surface points (all become mesh points).
+    pub n_surface_points: usize,
+    /// Interior nodes deployed.
+    pub n_interior_nodes: usize,
+    /// Finite tets of the Delaunay tetrahedralization (the convex hull).
+    pub n_delaunay_tets: usize,
+    /// Tets whose inside/outside status needed a centroid test (two or more surface vertices).
+    pub n_centroid_tests: usize,
+    /// Tets kept (inside a region).
+    pub n_tets: usize,
+    /// Points of the output mesh.
+    pub n_points: usize,
+    /// Input triangles that are not faces of the output mesh.
+    pub missing_triangles: usize,
+}
+
+/// Why the pipeline failed.
+#[derive(Debug, thiserror::Error)]
+pub enum PipelineError {
+    /// Node deployment failed.
+    #[error(transparent)]
+    Deploy(#[from] DeployError),
+    /// The Delaunay tetrahedralization failed.
+    #[error(transparent)]
+    Delaunay(#[from] DelaunayError),
+}
+
+/// Mesh the volume bounded by `surface` (validated: closed, consistently oriented, labelled).
+///
+/// The output's first points are the surface's points (same indices), then the interior nodes;
+/// tets carry the label of the region containing them. `progress` hears each stage's name as it
+/// starts.
+pub fn mesh_surface(
+    surface: &SurfaceMesh,
+    sizing: &Sizing,
+    opts: &PipelineOptions,
+    progress: &mut dyn FnMut(&str),
+) -> Result<(TetMesh, MeshReport), PipelineError> {
+    let start = Instant::now();
+    let mut report = MeshReport::default();
+    let stage = |report: &mut MeshReport, name: &'static str, clock: Instant| {
+        report.stages.push(StageReport {
+            name,
+            seconds: clock.elapsed().as_secs_f64(),
+        });
+    };
+
+    progress("deploying nodes");
+    let clock = Instant::now();
+    let dep = deploy(surface, sizing, &opts.deploy)?;
+    report.template = dep.stats.clone();
+    report.n_surface_points = dep.n_surface;
+    report.n_interior_nodes = dep.interior_regions.len();
+    stage(&mut report, "deploy", clock);
+
+    progress("tetrahedralizing");
+    let clock = Instant::now();
+    // The triangulation takes the points (no second copy); they come back by vertex number,
+    // which is the input order for distinct points.
+    let n_points = dep.points.len();
+    let del = Delaunay::from_points(dep.points)?;
+    report.n_delaunay_tets = del.n_finite_tets();
+    stage(&mut report, "delaunay", clock);
+
+    progress("removing outside tets");
+    let clock = Instant::now();
+    let map = del.vertex_map();
+    // Delaunay vertex number -> deployment index (inputs are distinct: interior nodes are never
+    // on the surface, so the map is a bijection unless the surface repeats a point).
+    let mut input_of = vec![u32::MAX; del.n_vertices()];
+    for (i, &v) in map.iter().enumerate() {
+        if input_of[v as usize] == u32::MAX {
+            input_of[v as usize] = i as u32;
+        }
+    }
+    let ns = dep.n_surface as u32;
+    let locator = RegionLocator::new(surface);
+    let mut scratch = Transitions::default();
+    // Which slots are kept, as a bitset with a rank per word: the kept tets' neighbours come
+    // from the triangulation's own adjacency (no face sorting, no per-slot index array).
+    let mut kept = vec![0u64; del.n_slots().div_ceil(64)];
+    let mut tets = Vec::with_capacity(del.n_finite_tets());
+    let mut labels = Vec::with_capacity(del.n_finite_tets());
+    for t in del.finite_tets() {
+        let w = del.tet(t);
+        let v = w.map(|x| input_of[x as usize]);
+        let on_surface = v.iter().filter(|&&x| x < ns).count();
+        let label = if on_surface >= 2 {
+            report.n_centroid_tests += 1;
+            centroid_region(del.tet_points(t), &locator, &mut scratch)
+        } else {
+            let i = v.iter().find(|&&x| x >= ns).copied().unwrap_or(0);
+            dep.interior_regions[(i - ns) as usize]
+        };
+        if label != 0 {
+            kept[t as usize / 64] |= 1 << (t % 64);
+            tets.push(v);
+            labels.push(label);
+        }
+    }
+    let mut rank = Vec::with_capacity(kept.len());
+    let mut r = 0u32;
+    for w in &kept {
+        rank.push(r);
+        r += w.count_ones();
+    }
+    let index_of = |t: u32| {
+        let (w, b) = (t as usize / 64, t % 64);
+        if kept[w] >> b & 1 == 0 {
+            NO_NEIGHBOR
+        } else {
+            rank[w] + (kept[w] & ((1u64 << b) - 1)).count_ones()
+        }
+    };
+    let neighbors: Vec<[u32; 4]> = del
+        .finite_tets()
+        .filter(|&t| kept[t as usize / 64] >> (t % 64) & 1 == 1)
+        .map(|t| del.adjacent(t).map(index_of))
+        .collect();
+    drop((kept, rank));
+    let mut points = del.into_vertex_points();
+    if points.len() != n_points {
+        // Repeated input points share a vertex: give every input index its coordinates back.
+        points = (0..n_points).map(|i| points[map[i] as usize]).collect();
+    }
+    let mesh = compact(points, tets, neighbors, labels);
+    stage(&mut report, "keep inside", clock);
+
+    report.missing_triangles = missing_triangles(&mesh, surface);
+    report.n_tets = mesh.tets.len();
+    report.n_points = mesh.points.len();
+    report.seconds_total = start.elapsed().as_secs_f64();
+    Ok((mesh, report))
+}
+
+/// Region of a tet by its centroid; if the centroid lies exactly on the surface, other interior
+/// points of the tet decide.
+fn centroid_region(c: [[f64; 3]; 4], locator: &RegionLocator, scratch: &mut Transitions) -> u32 {
+    for w in [
+        [1.0, 1.0, 1.0, 1.0],
+        [2.0, 1.0, 1.0, 1.0],
+        [1.0, 2.0, 1.0, 1.0],
+        [1.0, 1.0, 2.0, 1.0],
+    ] {
+        let s: f64 = w.iter().sum();
+        let p = [0, 1, 2].map(|a| (0..4).map(|k| w[k] * c[k][a]).sum::<f64>() / s);
+        if let Location::Region(r) = locator.locate_with(p, scratch) {
+            return r;
+        }
+    }
+    0
+}
+
+/// Assemble the mesh, dropping points no tet uses (the others keep their order, surface points
+/// first).
+fn compact(
+    points: Vec<[f64; 3]>,
+    mut tets: Vec<[u32; 4]>,
+    neighbors: Vec<[u32; 4]>,
+    labels: Vec<u32>,
+) -> TetMesh {
+    let mut used = vec![false; points.len()];
+    for t in &tets {
+        for &v in t {
+            used[v as usize] = true;
+        }
+    }
+    let mut new_index = vec![u32::MAX; points.len()];
+    let mut kept = Vec::with_capacity(points.len());
+    for (i, p) in points.into_iter().enumerate() {
+        if used[i] {
+            new_index[i] = kept.len() as u32;
+            kept.push(p);
+        }
+    }
+    if kept.len() != new_index.len() {
+        for t in &mut tets {
+            for v in t.iter_mut() {
+                *v = new_index[*v as usize];
+            }
+        }
+    }
+    TetMesh {
+        points: kept,
+        tets,
+        neighbors,
+        labels,
+    }
+}
+
+/// Input triangles that are not a face of any tet (matched by point coordinates).
+pub fn missing_triangles(mesh: &TetMesh, surface: &SurfaceMesh) -> usize {
+    let key = |p: &[f64; 3]| p.map(|c| if c == 0.0 { 0 } else { c.to_bits() });
+    let mut index: FxHashMap<[u64; 3], u32> = Default::default();
+    for (i, p) in surface.points.iter().enumerate() {
+        index.insert(key(p), i as u32);
+    }
+    // Mesh point -> surface point (u32::MAX for the others); only faces with three surface
+    // points can be surface triangles, so only those are hashed.
+    let on_surface: Vec<u32> = mesh
+        .points
+        .iter()
+        .map(|p| index.get(&key(p)).copied().unwrap_or(u32::MAX))
+        .collect();
+    let mut faces: FxHashSet<[u32; 3]> = Default::default();
+    for t in 0..mesh.tets.len() {
+        for f in 0..4 {
+            let mut k = mesh.face(t, f).map(|v| on_surface[v as usize]);
+            if k.contains(&u32::MAX) {
+                continue;
+            }
+            k.sort_unstable();
+            faces.insert(k);
+        }
+    }
+    surface
+        .triangles
+        .iter()
+        .filter(|tri| {
+            let mut k = **tri;
+            k.sort_unstable();
+            !faces.contains(&k)
+        })
+        .count()
+}

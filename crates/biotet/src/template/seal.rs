@@ -1,0 +1,140 @@
+//! The boundary buffer: a zone around every surface node (section 2.3.1) and the scaled-prism
+//! seal over triangles larger than their nodes' zones (eq. 2.7, fig. 2.7).
+//!
+//! Heights: a triangle's prism reaches `√(2/3)·d` from its plane, `d` interpolated from the sizes
+//! at its corners: the height of a regular tet of edge `d`, so the first interior node above a
+//! triangle makes a well-shaped tet with it. A triangle needs no prism when its longest edge is at
+//! most the smallest of its corner sizes: then every point of it is within `d/√3` of a corner and
+//! the corner zones alone keep nodes at least that same height away.
+
+use crate::geom::vec3::{add, cross, dot, norm, scale, sub};
+use crate::mesh::surface::SurfaceMesh;
+
+use super::voxels::{BUFFER, SURFACE_NODE, Template, UNPROCESSED, Zone};
+
+/// Ratio of a regular tet's height to its edge.
+pub const HEIGHT_FACTOR: f64 = 0.816_496_580_927_726; // √(2/3)
+
+/// Mark surface node voxels and their zones; `size[v]` is the desired size at surface point `v`
+/// (0 for unreferenced points, which are skipped).
+pub fn mark_surface_nodes(t: &mut Template, surface: &SurfaceMesh, size: &[f64], zone: Zone) {
+    for (v, p) in surface.points.iter().enumerate() {
+        if size[v] <= 0.0 {
+            continue;
+        }
+        let c = t.nearest(*p);
+        let idx = t.index(c[0], c[1], c[2]);
+        t.set_state(idx, SURFACE_NODE);
+        let r = (size[v] / t.dx).round().max(1.0) as usize;
+        t.mark_zone(c, r, zone);
+    }
+}
+
+/// Seal every triangle larger than its nodes' zones with a scaled prism; returns how many.
+pub fn seal_triangles(t: &mut Template, surface: &SurfaceMesh, size: &[f64]) -> usize {
+    let mut sealed = 0;
+    for tri in &surface.triangles {
+        let v = tri.map(|i| i as usize);
+        let p = v.map(|i| surface.points[i]);
+        let d = v.map(|i| size[i]);
+        let edges = [
+            norm(sub(p[1], p[2])),
+            norm(sub(p[2], p[0])),
+            norm(sub(p[0], p[1])),
+        ];
+        let longest = edges.iter().copied().fold(0.0, f64::max);
+        if longest <= d.iter().copied().fold(f64::INFINITY, f64::min) {
+            continue;
+        }
+        let nrm = cross(sub(p[1], p[0]), sub(p[2], p[0]));
+        let len = norm(nrm);
+        let per = edges[0] + edges[1] + edges[2];
+        if len == 0.0 || per == 0.0 || !len.is_finite() {
+            continue; // degenerate: validation rejects these before deployment
+        }
+        sealed += 1;
+        let n = scale(nrm, 1.0 / len);
+        // Incentre, and the corners pushed away from it by their sizes (eq. 2.7).
+        let o = scale(
+            add(
+                add(scale(p[0], edges[0]), scale(p[1], edges[1])),
+                scale(p[2], edges[2]),
+            ),
+            1.0 / per,
+        );
+        let q = [0, 1, 2].map(|i| {
+            let r = sub(p[i], o);
+            let l = norm(r);
+            add(o, scale(r, 1.0 + d[i] / l))
+        });
+        let h = d.map(|x| x * HEIGHT_FACTOR);
+        mark_prism(t, q, h, n);
+    }
+    sealed
+}
+
+/// Mark unprocessed voxels strictly inside the prism over triangle `q` (mid-plane) with normal
+/// `n` and half-height `h[i]` at corner `i`, interpolated linearly.
+fn mark_prism(t: &mut Template, q: [[f64; 3]; 3], h: [f64; 3], n: [f64; 3]) {
+    let hmax = h.iter().copied().fold(0.0, f64::max);
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for c in &q {
+        for a in 0..3 {
+            let e = hmax * n[a].abs();
+            lo[a] = lo[a].min(c[a] - e);
+            hi[a] = hi[a].max(c[a] + e);
+        }
+    }
+    let inv = 1.0 / t.dx;
+    let span = |a: usize| {
+        let l = ((lo[a] - t.origin[a]) * inv).ceil().max(0.0) as usize;
+        let h = ((hi[a] - t.origin[a]) * inv).floor();
+        let h = if h < 0.0 {
+            None
+        } else {
+            Some((h as usize).min(t.n[a] - 1))
+        };
+        (l, h)
+    };
+    let (i0, i1) = span(0);
+    let (j0, j1) = span(1);
+    let (k0, k1) = span(2);
+    let (Some(i1), Some(j1), Some(k1)) = (i1, j1, k1) else {
+        return;
+    };
+    // Barycentric coordinates in the plane: solve with the 2×2 Gram system of the two edges.
+    let e1 = sub(q[1], q[0]);
+    let e2 = sub(q[2], q[0]);
+    let (a11, a12, a22) = (dot(e1, e1), dot(e1, e2), dot(e2, e2));
+    let det = a11 * a22 - a12 * a12;
+    if det <= 0.0 || !det.is_finite() {
+        return;
+    }
+    let inv_det = 1.0 / det;
+    for k in k0..=k1 {
+        for j in j0..=j1 {
+            let row = t.index(0, j, k);
+            for i in i0..=i1 {
+                let idx = row + i;
+                if t.state(idx) != UNPROCESSED {
+                    continue;
+                }
+                let x = t.point([i, j, k]);
+                let r = sub(x, q[0]);
+                let dist = dot(r, n);
+                let (b1, b2) = (dot(r, e1), dot(r, e2));
+                let l1 = (a22 * b1 - a12 * b2) * inv_det;
+                let l2 = (a11 * b2 - a12 * b1) * inv_det;
+                let l0 = 1.0 - l1 - l2;
+                if l0 < 0.0 || l1 < 0.0 || l2 < 0.0 {
+                    continue;
+                }
+                let height = l0 * h[0] + l1 * h[1] + l2 * h[2];
+                if dist.abs() < height {
+                    t.set_state(idx, BUFFER);
+                }
+            }
+        }
+    }
+}
