@@ -13,6 +13,7 @@ pub mod delaunay;
 pub mod geom;
 pub mod mesh;
 pub mod quality;
+pub mod sizing_grid;
 
 pub use mesh::surface::SurfaceMesh;
 pub use mesh::tet::{NO_NEIGHBOR, TET_FACES, TetMesh};

@@ -5,4 +5,5 @@ mod common;
 mod delaunay;
 mod predicates;
 mod quality;
+mod sizing_grid;
 mod validate;
