@@ -47,6 +47,7 @@ pub mod points;
 pub mod stl;
 pub mod tetgen;
 mod text;
+mod vtkxml;
 pub mod vtu;
 
 pub use error::{Error, Result};
