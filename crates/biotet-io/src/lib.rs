@@ -5,6 +5,7 @@
 //! | surface ([`SurfaceMesh`]) | STL `.stl` (ASCII/binary), OBJ `.obj`, OFF `.off`, PLY `.ply` (ASCII/binary LE/BE), Medit `.mesh` | ✓ | ✓ |
 //! | tet mesh ([`TetMesh`]) | VTU `.vtu`, Medit `.mesh`, Gmsh `.msh` (4.1 ASCII/binary, 2.2 ASCII), TetGen `.node`/`.ele`(/`.face`) | ✓ | ✓ |
 //! | 2D mesh ([`TriMesh`]) | Medit `.mesh` (`Dimension 2`), Triangle `.node`/`.ele` | ✓ | ✓ |
+//! | scalar grid ([`ScalarGrid`](biotet::sizing_grid::ScalarGrid)) | VTK ImageData `.vti`, NIfTI-1/2 `.nii`, `.nii.gz` ([`read_scalar_grid`], [`grid`]) | ✓ | |
 //!
 //! The path-based entry points ([`read_surface`], [`write_surface`], [`read_tet_mesh`],
 //! [`write_tet_mesh`], [`read_tri_mesh`], [`write_tri_mesh`]) choose the format by extension;
@@ -39,6 +40,7 @@ mod b64;
 mod common;
 pub mod error;
 pub mod gmsh;
+pub mod grid;
 pub mod medit;
 pub mod obj;
 pub mod off;
@@ -47,9 +49,11 @@ pub mod points;
 pub mod stl;
 pub mod tetgen;
 mod text;
+mod vtkxml;
 pub mod vtu;
 
 pub use error::{Error, Result};
+pub use grid::{read_scalar_grid, read_scalar_grid_named};
 pub use points::read_points;
 pub use tetgen::{TetgenFiles, TetgenOptions};
 pub use vtu::VtuEncoding;

@@ -15,6 +15,7 @@ pub mod mesh;
 pub mod pipeline;
 pub mod quality;
 pub mod sizing;
+pub mod sizing_grid;
 pub mod template;
 
 pub use mesh::surface::SurfaceMesh;

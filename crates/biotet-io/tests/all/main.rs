@@ -4,6 +4,7 @@ mod atomic;
 mod common;
 mod dispatch;
 mod external;
+mod grid;
 mod malformed;
 mod real_data;
 mod surface;

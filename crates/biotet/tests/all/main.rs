@@ -5,5 +5,6 @@ mod common;
 mod delaunay;
 mod predicates;
 mod quality;
+mod sizing_grid;
 mod template;
 mod validate;

@@ -1,0 +1,205 @@
+#!/usr/bin/env python3
+"""Surface to tet mesh: biotet `mesh` beside TetGen (surface kept, `pq1.2Y`) on the same surface, in one run.
+
+    pip install tetgen meshio numpy        # the anchor (pip tetgen wraps TetGen 1.6); apt-get install tetgen for 1.5
+    cargo build --release -p biotet-cli
+    python3 scripts/bench_mesh.py [SURFACE.stl ...] [--repeat 3] [--scaling] [--json out.json]
+
+Every tool runs in its own process. Times are medians of the repeats: biotet's pipeline seconds (its `--json`,
+without reading and writing files) and the process wall time; TetGen's time of the `tetrahedralize` call (pip) or its
+own "Total running seconds" (binary). Peak memory is the process's peak RSS minus its RSS before meshing (biotet
+resets the peak after reading the surface; the pip child records its RSS before the call). Quality comes from one
+routine for all tools: `biotet quality --json` on each output; missing input triangles from `biotet check --surface`.
+
+--scaling meshes the first surface at several uniform sizes and prints seconds per tet (dissertation fig. 2.16).
+"""
+import argparse, json, os, shutil, statistics, subprocess, sys, tempfile, textwrap, time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+BIOTET = os.path.join(ROOT, "target", "release", "biotet")
+DEFAULT = [os.path.join(ROOT, "tests", "data", "brain_20k.stl")]
+
+PIP_TETGEN = textwrap.dedent(r'''
+    import json, resource, sys, time
+    import numpy as np, meshio, tetgen
+    surface, switches, node = sys.argv[1], sys.argv[2], sys.argv[3]
+    m = meshio.read(surface)
+    p = np.asarray(m.points, dtype=float)
+    t = np.asarray(m.cells_dict["triangle"], dtype=np.int32)
+    # STL repeats each corner: weld exactly equal points as every mesher does.
+    p, inv = np.unique(p, axis=0, return_inverse=True)
+    t = inv.reshape(-1)[t]
+    def rss_kb():
+        with open("/proc/self/status") as f:
+            for line in f:
+                if line.startswith("VmRSS"):
+                    return int(line.split()[1])
+    before = rss_kb()
+    g = tetgen.TetGen(p, t)
+    start = time.perf_counter()
+    res = g.tetrahedralize(switches=switches)
+    seconds = time.perf_counter() - start
+    nodes, elems = res[0], res[1]
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    with open(node + ".node", "w") as f:
+        f.write(f"{len(nodes)} 3 0 0\n")
+        for i, q in enumerate(nodes):
+            f.write(f"{i} {float(q[0])!r} {float(q[1])!r} {float(q[2])!r}\n")
+    with open(node + ".ele", "w") as f:
+        f.write(f"{len(elems)} 4 0\n")
+        for i, e in enumerate(elems):
+            f.write(f"{i} {e[0]} {e[1]} {e[2]} {e[3]}\n")
+    print(json.dumps({"seconds": seconds, "rss_before_kb": before, "peak_rss_kb": peak}))
+''')
+
+
+def biotet_json(*args):
+    r = subprocess.run([BIOTET, *args, "--json"], capture_output=True, text=True)
+    if r.returncode not in (0, 1):
+        raise RuntimeError(f"biotet {' '.join(args)}: {r.stderr.strip()}")
+    return json.loads(r.stdout)
+
+
+def measure(mesh, surface):
+    q = biotet_json("quality", mesh)
+    c = biotet_json("check", mesh, "--surface", surface)
+    conf = c.get("surface") or {}
+    return {
+        "points": q.get("n_points"), "tets": q.get("n_tets"),
+        "min_dihedral": q.get("min_dihedral_deg"), "max_dihedral": q.get("max_dihedral_deg"),
+        "min_solid_sr": q.get("min_solid_angle_sr"), "mean_q": q.get("mean_q"),
+        "lt5": q.get("n_dihedral_lt_5"), "lt10": q.get("n_dihedral_lt_10"), "lt20": q.get("n_dihedral_lt_20"),
+        "missing": (conf.get("n_triangles", 0) - conf.get("n_found", 0)) if conf else None,
+        "valid": c.get("valid"),
+    }
+
+
+def run_biotet(surface, out, extra, repeat):
+    rows = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        j = biotet_json("mesh", surface, "-o", out, *extra)
+        wall = time.perf_counter() - start
+        rows.append({"seconds": j["pipeline"]["seconds_total"], "wall": wall,
+                     "mem_kb": j["peak_rss_kb"] - j["rss_before_kb"], "mesh_bytes": j["mesh_bytes"]})
+    return rows
+
+
+def run_pip_tetgen(surface, switches, base, repeat):
+    rows = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        r = subprocess.run([sys.executable, "-c", PIP_TETGEN, surface, switches, base],
+                           capture_output=True, text=True)
+        wall = time.perf_counter() - start
+        if r.returncode != 0:
+            return None, (r.stderr.strip().splitlines() or ["failed"])[-1]
+        j = json.loads(r.stdout.strip().splitlines()[-1])
+        rows.append({"seconds": j["seconds"], "wall": wall, "mem_kb": j["peak_rss_kb"] - j["rss_before_kb"]})
+    return rows, None
+
+
+def run_tetgen_binary(surface, switches, tmp, repeat):
+    exe = shutil.which("tetgen")
+    if not exe:
+        return None, "tetgen binary not found (apt-get install tetgen)", None
+    src = os.path.join(tmp, "tg_input.stl")
+    shutil.copy(surface, src)
+    rows = []
+    import re
+    for _ in range(repeat):
+        start = time.perf_counter()
+        r = subprocess.run(["/usr/bin/time", "-f", "PEAK %M", exe, "-" + switches + "V", src],
+                           capture_output=True, text=True)
+        wall = time.perf_counter() - start
+        if r.returncode != 0:
+            return None, r.stderr.strip()[-200:], None
+        sec = re.search(r"Total running seconds:\s*([0-9.e-]+)", r.stdout)
+        peak = re.search(r"PEAK (\d+)", r.stderr)
+        rows.append({"seconds": float(sec.group(1)) if sec else wall, "wall": wall,
+                     "mem_kb": int(peak.group(1)) if peak else None})
+    return rows, None, os.path.join(tmp, "tg_input.1.node")
+
+
+def med(rows, key):
+    vals = [r[key] for r in rows if r.get(key) is not None]
+    return statistics.median(vals) if vals else None
+
+
+def fmt(v, spec):
+    return "–" if v is None else format(v, spec)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("surfaces", nargs="*", default=DEFAULT)
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--switches", default="pq1.2Y")
+    ap.add_argument("--scaling", action="store_true")
+    ap.add_argument("--json")
+    a = ap.parse_args()
+    if not os.path.exists(BIOTET):
+        sys.exit(f"{BIOTET} not found: cargo build --release -p biotet-cli")
+    results = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for s in a.surfaces:
+            name = os.path.basename(s)
+            out = os.path.join(tmp, "biotet.vtu")
+            rows = run_biotet(s, out, [], a.repeat)
+            r = {"surface": name, "tool": "biotet mesh", "seconds": med(rows, "seconds"), "wall": med(rows, "wall"),
+                 "mem_mb": med(rows, "mem_kb") / 1024, "mesh_mb": rows[0]["mesh_bytes"] / 2**20, **measure(out, s)}
+            results.append(r)
+            base = os.path.join(tmp, "pip_tetgen")
+            rows, err = run_pip_tetgen(s, a.switches, base, a.repeat)
+            if rows:
+                results.append({"surface": name, "tool": f"TetGen {a.switches} (pip tetgen)",
+                                "seconds": med(rows, "seconds"), "wall": med(rows, "wall"),
+                                "mem_mb": med(rows, "mem_kb") / 1024, **measure(base + ".node", s)})
+            else:
+                print(f"pip tetgen skipped: {err}", file=sys.stderr)
+            rows, err, node = run_tetgen_binary(s, a.switches, tmp, a.repeat)
+            if rows:
+                results.append({"surface": name, "tool": f"TetGen 1.5 {a.switches} (Debian binary)",
+                                "seconds": med(rows, "seconds"), "wall": med(rows, "wall"),
+                                "mem_mb": med(rows, "mem_kb") / 1024, **measure(node, s)})
+            else:
+                print(f"tetgen binary skipped: {err}", file=sys.stderr)
+        print("| surface | tool | seconds (median) | wall s | peak MB | points | tets | min dihedral ° | max dihedral ° "
+              "| mean q | tets <5° | <10° | <20° | missing triangles | valid |")
+        print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+        for r in results:
+            print(f"| {r['surface']} | {r['tool']} | {fmt(r['seconds'], '.3f')} | {fmt(r['wall'], '.3f')} "
+                  f"| {fmt(r['mem_mb'], '.1f')} | {r['points']} | {r['tets']} | {fmt(r['min_dihedral'], '.4f')} "
+                  f"| {fmt(r['max_dihedral'], '.2f')} | {fmt(r['mean_q'], '.3f')} | {r['lt5']} | {r['lt10']} "
+                  f"| {r['lt20']} | {r['missing']} | {r['valid']} |")
+        if results and results[0].get("mesh_mb"):
+            r = results[0]
+            print(f"\nbiotet: peak memory {r['mem_mb']:.1f} MB for an output mesh of {r['mesh_mb']:.1f} MB in memory "
+                  f"({r['mem_mb'] / r['mesh_mb']:.2f}×)")
+        scaling = []
+        if a.scaling:
+            s = a.surfaces[0]
+            print("\n| uniform size | points | tets | seconds (median) | µs per tet | template MB | peak MB |")
+            print("|---|---|---|---|---|---|---|")
+            for h in ["4", "3", "2", "1.5", "1.2"]:
+                out = os.path.join(tmp, "scale.vtu")
+                rows = []
+                for _ in range(a.repeat):
+                    j = biotet_json("mesh", s, "--size", h)
+                    rows.append({"seconds": j["pipeline"]["seconds_total"], "tets": j["pipeline"]["n_tets"],
+                                 "points": j["pipeline"]["n_points"], "tmpl": j["pipeline"]["template"]["bytes"],
+                                 "mem_kb": j["peak_rss_kb"] - j["rss_before_kb"]})
+                sec = med(rows, "seconds")
+                row = {"size": float(h), "points": rows[0]["points"], "tets": rows[0]["tets"], "seconds": sec,
+                       "us_per_tet": sec / rows[0]["tets"] * 1e6, "template_mb": rows[0]["tmpl"] / 1e6,
+                       "mem_mb": med(rows, "mem_kb") / 1024}
+                scaling.append(row)
+                print(f"| {h} | {row['points']} | {row['tets']} | {sec:.3f} | {row['us_per_tet']:.3f} "
+                      f"| {row['template_mb']:.1f} | {row['mem_mb']:.1f} |")
+        if a.json:
+            with open(a.json, "w") as f:
+                json.dump({"results": results, "scaling": scaling}, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()
