@@ -48,6 +48,8 @@ fn help_everywhere() {
         vec!["check", "--help"],
         vec!["convert", "--help"],
         vec!["validate", "--help"],
+        vec!["mesh", "--help"],
+        vec!["delaunay", "--help"],
     ] {
         let out = biotet(&cmd);
         assert!(out.status.success(), "{cmd:?}");
@@ -484,5 +486,117 @@ fn delaunay_refuses_bad_point_files() {
             assert!(msg.contains(w), "{name}: {msg}");
         }
         assert!(!dir.path().join("o.vtu").exists());
+    }
+}
+
+#[test]
+fn mesh_the_bundled_example_and_report() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("brain.vtu");
+    let j = json_of(&biotet(&["mesh", "-o", s(&out), "--json"]));
+    let p = &j["pipeline"];
+    assert!(p["n_tets"].as_u64().unwrap() > 50_000, "{p}");
+    assert!(p["n_interior_nodes"].as_u64().unwrap() > 1_000, "{p}");
+    assert_eq!(p["n_surface_points"], 9770);
+    let t = &p["template"];
+    assert_eq!(
+        t["voxels"].as_u64(),
+        Some(
+            t["dims"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|d| d.as_u64().unwrap())
+                .product()
+        )
+    );
+    assert_eq!(t["bytes"], t["voxels"]);
+    assert!(p["missing_triangles"].is_u64());
+    for k in ["deploy", "delaunay", "keep inside"] {
+        assert!(
+            p["stages"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|s| s["name"] == k),
+            "{k}"
+        );
+    }
+    assert_eq!(j["quality"]["n_tets"], p["n_tets"]);
+    assert_eq!(j["quality"]["n_inverted"], 0);
+    // The written mesh is valid (positive tets, conforming faces, adjacency, labels).
+    let c = biotet(&["check", s(&out), "--json"]);
+    let cj: Value = serde_json::from_slice(&c.stdout).unwrap();
+    assert_eq!(cj["n_nonpositive"], 0, "{cj}");
+    assert_eq!(cj["n_overshared_faces"], 0, "{cj}");
+    assert_eq!(cj["n_adjacency_errors"], 0, "{cj}");
+    // Same input and options, byte-identical output.
+    let again = dir.path().join("again.vtu");
+    let out2 = biotet(&["mesh", "-o", s(&again), "--quiet"]);
+    assert!(out2.status.success());
+    assert_eq!(std::fs::read(&out).unwrap(), std::fs::read(&again).unwrap());
+}
+
+#[test]
+fn mesh_sizing_options() {
+    let dir = tempfile::tempdir().unwrap();
+    let brain = brain_surface();
+    let n_tets = |args: &[&str]| {
+        let mut a = vec!["mesh", s(&brain), "--json"];
+        a.extend_from_slice(args);
+        json_of(&biotet(&a))["pipeline"]["n_tets"].as_u64().unwrap()
+    };
+    // Finer uniform sizes give more tets, about (4/3)^3 ≈ 2.4 times as many.
+    let coarse = n_tets(&["--size", "4"]);
+    let fine = n_tets(&["--size", "3"]);
+    assert!(
+        fine as f64 > 1.8 * coarse as f64 && (fine as f64) < 3.0 * coarse as f64,
+        "{coarse} {fine}"
+    );
+    // A size field: 2 at the front half (y > 0), 4 behind, on a .vti grid.
+    let (nx, ny, nz, o, sp) = (8, 10, 8, [-80.0, -115.0, -80.0], 25.0);
+    let mut vals = Vec::new();
+    for _k in 0..nz {
+        for j in 0..ny {
+            for _i in 0..nx {
+                let y = o[1] + j as f64 * sp;
+                vals.push(if y > 0.0 { "2" } else { "4" });
+            }
+        }
+    }
+    let vti = dir.path().join("size.vti");
+    std::fs::write(
+        &vti,
+        format!(
+            "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"0.1\" byte_order=\"LittleEndian\">\n\
+             <ImageData WholeExtent=\"0 {} 0 {} 0 {}\" Origin=\"{} {} {}\" Spacing=\"{sp} {sp} {sp}\">\n\
+             <Piece Extent=\"0 {} 0 {} 0 {}\"><PointData Scalars=\"size\">\
+             <DataArray type=\"Float64\" Name=\"size\" format=\"ascii\">{}</DataArray>\
+             </PointData></Piece></ImageData></VTKFile>\n",
+            nx - 1, ny - 1, nz - 1, o[0], o[1], o[2], nx - 1, ny - 1, nz - 1, vals.join(" ")
+        ),
+    )
+    .unwrap();
+    let field = n_tets(&["--size-field", s(&vti)]);
+    assert!(
+        field > coarse && field < n_tets(&["--size", "2"]),
+        "{field}"
+    );
+    // Bad options are refused with the reason.
+    for (args, needle) in [
+        (vec!["--size", "0"], "size must be a positive"),
+        (
+            vec!["--size", "2", "--size-from-surface"],
+            "cannot be used with",
+        ),
+        (vec!["--region-size", "x"], "LABEL=H"),
+        (vec!["--size", "1e-4"], "voxels"),
+        (vec!["--size-field", "/nonexistent/size.vti"], "size.vti"),
+    ] {
+        let mut a = vec!["mesh", s(&brain)];
+        a.extend_from_slice(&args);
+        let out = biotet(&a);
+        assert!(!out.status.success(), "{args:?}");
+        assert!(stderr(&out).contains(needle), "{args:?}: {}", stderr(&out));
     }
 }

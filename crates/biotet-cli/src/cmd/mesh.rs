@@ -27,7 +27,7 @@ enum ZoneArg {
 
 /// Arguments of `biotet mesh`.
 #[derive(clap::Args)]
-#[command(group(clap::ArgGroup::new("sizing").args(["size", "size_from_surface"])))]
+#[command(group(clap::ArgGroup::new("sizing").args(["size", "size_from_surface", "size_field"])))]
 pub struct Args {
     /// Closed surface (.stl, .obj, .off, .ply, .mesh, .vtu). Without one, the bundled brain
     /// example is meshed.
@@ -43,6 +43,13 @@ pub struct Args {
     /// growing with distance from the surface by --grading, up to --max-size.
     #[arg(long)]
     size_from_surface: bool,
+    /// Desired edge length from a regular grid file (VTK image data .vti, NIfTI .nii/.nii.gz),
+    /// interpolated trilinearly, clamped to the grid outside it; in the surface's coordinates.
+    #[arg(long, value_name = "FILE")]
+    size_field: Option<PathBuf>,
+    /// Which array of a .vti size field (default: the active point scalars, else the first).
+    #[arg(long, value_name = "NAME", requires = "size_field")]
+    size_field_array: Option<String>,
     /// Growth of the surface-derived size per unit of distance from the surface.
     #[arg(long, value_name = "G", default_value_t = 0.3)]
     grading: f64,
@@ -132,9 +139,24 @@ pub fn run(a: Args) -> Result<ExitCode> {
     let _ = std::fs::write("/proc/self/clear_refs", "5");
     let (_, rss_before_kb) = super::delaunay::memory_kb();
 
-    let spec = match a.size {
-        Some(h) => SizeSpec::Uniform(h),
-        None => SizeSpec::FromSurface { grading: a.grading },
+    let spec = match (a.size, &a.size_field) {
+        (Some(h), _) => SizeSpec::Uniform(h),
+        (None, Some(path)) => {
+            let grid = biotet_io::read_scalar_grid_named(path, a.size_field_array.as_deref())?;
+            let (min, max) = (grid.min_value(), grid.max_value());
+            if !(min > 0.0) {
+                bail!(
+                    "{}: the size field's smallest value is {min}; sizes must be positive",
+                    path.display()
+                );
+            }
+            SizeSpec::Field {
+                size: Box::new(move |p| grid.value_at(p)),
+                min,
+                max,
+            }
+        }
+        (None, None) => SizeSpec::FromSurface { grading: a.grading },
     };
     let mut sizing = SizingOptions::new(spec);
     sizing.min_size = a.min_size;

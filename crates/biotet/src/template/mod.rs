@@ -131,6 +131,16 @@ pub struct Deployment {
     pub stats: TemplateStats,
 }
 
+/// The largest `m·2^e ≤ x` with an 8-bit mantissa `m` (at most 0.8% below `x`).
+fn dyadic_below(x: f64) -> f64 {
+    if !(x > 0.0 && x.is_finite()) {
+        return x;
+    }
+    let scale = 2f64.powi(x.log2().floor() as i32 - 7);
+    let d = (x / scale).floor() * scale;
+    if d > 0.0 { d } else { x }
+}
+
 /// The size at each surface point: the smallest over the regions on either side of its
 /// triangles (0 for points no triangle uses).
 pub fn surface_node_sizes(surface: &SurfaceMesh, sizing: &Sizing) -> Vec<f64> {
@@ -171,7 +181,7 @@ pub fn deploy(
         return Err(DeployError::Resolution(opts.resolution));
     }
     let min_size = sizing.min_size();
-    let dx = min_size / opts.resolution;
+    let dx = dyadic_below(min_size / opts.resolution);
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     for tri in &surface.triangles {
@@ -184,7 +194,7 @@ pub fn deploy(
         }
     }
     let m = opts.margin as f64;
-    let dims_f = [0, 1, 2].map(|a| ((hi[a] - lo[a]) / dx).ceil() + 2.0 * m + 1.0);
+    let dims_f = [0, 1, 2].map(|a| (hi[a] / dx).ceil() - (lo[a] / dx).floor() + 2.0 * m + 1.0);
     let voxels = dims_f[0] * dims_f[1] * dims_f[2];
     if voxels.is_nan() || voxels > opts.max_voxels as f64 {
         return Err(DeployError::TooLarge {
@@ -199,7 +209,10 @@ pub fn deploy(
         });
     }
     let dims = dims_f.map(|d| d as usize);
-    let origin = [0, 1, 2].map(|a| lo[a] - m * dx);
+    // Origin on a multiple of dx: with dx's 8-bit mantissa every voxel coordinate k·dx is then
+    // exact, so interior nodes form an exact lattice whose degeneracies (cospherical cubes) are
+    // exact zeros for the predicates' symbolic perturbation, not float noise near zero.
+    let origin = [0, 1, 2].map(|a| ((lo[a] / dx).floor() - m) * dx);
     let mut t = Template::new(dims, origin, dx);
     let mut stats = TemplateStats {
         dims,

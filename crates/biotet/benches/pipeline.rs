@@ -1,0 +1,39 @@
+//! The surface-to-mesh pipeline (node deployment, Delaunay, outside removal) on the real brain
+//! surface at four uniform sizes, from about 150 thousand to 2.6 million tets: the time per tet
+//! should stay flat (dissertation fig. 2.16: time linear in the number of tets).
+//!
+//! `cargo bench -p biotet --bench pipeline`; throughput is reported in tets per second.
+
+use biotet::pipeline::{PipelineOptions, mesh_surface};
+use biotet::sizing::Sizing;
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use std::path::Path;
+use std::time::Duration;
+
+fn bench(c: &mut Criterion) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/brain_20k.stl");
+    let surface = biotet_io::read_surface(&path).expect("brain_20k.stl").mesh;
+    let mut g = c.benchmark_group("pipeline");
+    g.sample_size(10);
+    g.warm_up_time(Duration::from_secs(1));
+    for h in [4.0, 3.0, 2.0, 1.5] {
+        let sizing = Sizing::uniform(h).expect("size");
+        let opts = PipelineOptions::default();
+        let (mesh, _) = mesh_surface(&surface, &sizing, &opts, &mut |_| {}).expect("mesh");
+        g.throughput(Throughput::Elements(mesh.tets.len() as u64));
+        g.bench_with_input(
+            BenchmarkId::new(
+                "brain_20k_uniform",
+                format!("h={h} ({} tets)", mesh.tets.len()),
+            ),
+            &sizing,
+            |b, sizing| {
+                b.iter(|| mesh_surface(&surface, sizing, &opts, &mut |_| {}).expect("mesh"))
+            },
+        );
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
