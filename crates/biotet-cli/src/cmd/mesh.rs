@@ -144,7 +144,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
         (None, Some(path)) => {
             let grid = biotet_io::read_scalar_grid_named(path, a.size_field_array.as_deref())?;
             let (min, max) = (grid.min_value(), grid.max_value());
-            if !(min > 0.0) {
+            if min.is_nan() || min <= 0.0 {
                 bail!(
                     "{}: the size field's smallest value is {min}; sizes must be positive",
                     path.display()
