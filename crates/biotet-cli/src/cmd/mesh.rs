@@ -5,7 +5,7 @@ use anyhow::{Context, Result, bail};
 use biotet::SurfaceMesh;
 use biotet::mesh::validate::{ValidateOptions, validate_surface};
 use biotet::pipeline::{PipelineOptions, mesh_surface};
-use biotet::quality::QualityReport;
+use biotet::quality::{QualityReport, forced};
 use biotet::sizing::{SizeSpec, Sizing, SizingOptions};
 use biotet::template::Zone;
 use serde_json::json;
@@ -16,6 +16,8 @@ use std::time::Instant;
 /// The bundled example: a real brain surface (MNI ICBM152, 19,648 triangles), see tests/data.
 const EXAMPLE: &[u8] = include_bytes!("../../../../tests/data/brain_20k.stl");
 const EXAMPLE_NAME: &str = "brain_20k.stl (bundled example)";
+/// Angle below which an input triangle or fold forces its tets (degrees).
+const FORCED_DEG: f64 = 10.0;
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug)]
 enum ZoneArg {
@@ -176,6 +178,10 @@ pub fn run(a: Args) -> Result<ExitCode> {
 
     stage.set("measuring");
     let quality = QualityReport::of(&mesh);
+    let forcing = {
+        let f = forced::classify(&mesh, &surface, FORCED_DEG);
+        forced::summarise(&mesh, &f, FORCED_DEG)
+    };
     if let Some(out) = &a.output {
         stage.set(format!("writing {}", out.display()));
         biotet_io::write_tet_mesh(out, &mesh)?;
@@ -231,6 +237,11 @@ pub fn run(a: Args) -> Result<ExitCode> {
             quality.max_dihedral_deg.unwrap_or(f64::NAN),
             quality.n_dihedral_lt_10,
             quality.mean_q.unwrap_or(f64::NAN)
+        );
+        text += &format!(
+            "\nforced by the input (a face or fold under {FORCED_DEG}°): {} tets; unforced tets \
+             below 10°: {}",
+            forcing.n_forced, forcing.n_unforced_dihedral_lt_10
         );
         crate::emit(&text);
     }

@@ -3,6 +3,7 @@
 //!
 //! Measures are floating point on purpose: they rank and report, they never decide topology.
 
+pub mod forced;
 pub mod report;
 pub mod tet;
 pub mod tri;

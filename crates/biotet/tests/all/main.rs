@@ -3,6 +3,7 @@
 mod check;
 mod common;
 mod delaunay;
+mod forced;
 mod predicates;
 mod quality;
 mod sizing_grid;

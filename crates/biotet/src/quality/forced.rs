@@ -1,0 +1,259 @@
+//! Where a tet sits relative to the input surface, and whether the input forces it to be poor.
+//!
+//! Marching-cubes surfaces carry triangles with angles of 0.01° and folds where two triangles
+//! meet at a tiny interior angle. Any mesh that keeps the surface must then contain a tet with a
+//! tiny solid (and usually dihedral) angle there, whatever the fill: such a tet is *forced*. A tet
+//! is forced when
+//! - one of its faces is an input triangle whose smallest angle is below the threshold, or
+//! - one of its edges is an input edge at which the surface, seen from the tet's region, folds
+//!   to an interior dihedral angle below the threshold.
+//!
+//! Quality reports split forced from unforced tets: the unforced ones are what a mesher can fix.
+//! Surface triangles are matched to mesh faces by exact point coordinates.
+
+use rustc_hash::FxHashMap;
+use serde::Serialize;
+
+use crate::geom::vec3::{cross, dot, norm, sub};
+use crate::mesh::surface::SurfaceMesh;
+use crate::mesh::tet::{TET_EDGES, TET_FACES, TetMesh};
+use crate::quality::tet::dihedral_angles;
+
+/// Where a tet touches the input surface.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Placement {
+    /// One of its faces is an input triangle.
+    Face,
+    /// It has a surface point but no input triangle as a face.
+    Vertex,
+    /// No surface point.
+    Interior,
+}
+
+/// Per-tet placement and forcing.
+#[derive(Debug, Clone)]
+pub struct Forcing {
+    /// Placement of each tet.
+    pub placement: Vec<Placement>,
+    /// Whether each tet is forced poor by the input.
+    pub forced: Vec<bool>,
+}
+
+/// Counts of [`classify`], with the quality of the unforced tets.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct ForcingSummary {
+    /// The angle threshold used (degrees).
+    pub threshold_deg: f64,
+    /// Tets with an input triangle as a face.
+    pub n_face: usize,
+    /// Tets touching the surface at a point only.
+    pub n_vertex: usize,
+    /// Tets away from the surface.
+    pub n_interior: usize,
+    /// Forced tets.
+    pub n_forced: usize,
+    /// Forced tets whose smallest dihedral angle is below 10°.
+    pub n_forced_dihedral_lt_10: usize,
+    /// Unforced tets whose smallest dihedral angle is below 5°.
+    pub n_unforced_dihedral_lt_5: usize,
+    /// Unforced tets whose smallest dihedral angle is below 10°.
+    pub n_unforced_dihedral_lt_10: usize,
+    /// Unforced tets whose smallest dihedral angle is below 20°.
+    pub n_unforced_dihedral_lt_20: usize,
+    /// Smallest dihedral angle of an unforced tet.
+    pub unforced_min_dihedral_deg: Option<f64>,
+    /// Tets below 10° by placement: `[face, vertex, interior]`.
+    pub dihedral_lt_10_by_placement: [usize; 3],
+}
+
+#[inline]
+fn key(p: &[f64; 3]) -> [u64; 3] {
+    p.map(|c| if c == 0.0 { 0 } else { c.to_bits() })
+}
+
+#[inline]
+fn sorted3(mut a: [u32; 3]) -> [u32; 3] {
+    a.sort_unstable();
+    a
+}
+
+/// Smallest angle (degrees) of a triangle.
+fn min_angle_deg(t: [[f64; 3]; 3]) -> f64 {
+    (0..3)
+        .map(|i| {
+            let u = sub(t[(i + 1) % 3], t[i]);
+            let v = sub(t[(i + 2) % 3], t[i]);
+            norm(cross(u, v)).atan2(dot(u, v)).to_degrees()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Classify every tet of `mesh` against `surface` with the angle `threshold_deg`.
+pub fn classify(mesh: &TetMesh, surface: &SurfaceMesh, threshold_deg: f64) -> Forcing {
+    // Mesh point -> surface point.
+    let mut index: FxHashMap<[u64; 3], u32> = Default::default();
+    for (i, p) in surface.points.iter().enumerate() {
+        index.insert(key(p), i as u32);
+    }
+    let surf_of: Vec<u32> = mesh
+        .points
+        .iter()
+        .map(|p| index.get(&key(p)).copied().unwrap_or(u32::MAX))
+        .collect();
+    // Input triangles (sorted surface ids) -> poor?
+    let mut triangles: FxHashMap<[u32; 3], bool> = Default::default();
+    // Input edges -> (triangle, opposite vertex) per use, for the fold angles.
+    let mut edges: FxHashMap<[u32; 2], Vec<(u32, u32)>> = Default::default();
+    for (t, tri) in surface.triangles.iter().enumerate() {
+        let poor = min_angle_deg(surface.corners(t)) < threshold_deg;
+        triangles.insert(sorted3(*tri), poor);
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            edges
+                .entry([a.min(b), a.max(b)])
+                .or_default()
+                .push((t as u32, tri[(k + 2) % 3]));
+        }
+    }
+    let mut placement = Vec::with_capacity(mesh.tets.len());
+    let mut forced = Vec::with_capacity(mesh.tets.len());
+    for (t, tet) in mesh.tets.iter().enumerate() {
+        let s = tet.map(|v| surf_of[v as usize]);
+        let n_surf = s.iter().filter(|&&x| x != u32::MAX).count();
+        let mut place = if n_surf > 0 {
+            Placement::Vertex
+        } else {
+            Placement::Interior
+        };
+        let mut is_forced = false;
+        if n_surf >= 3 {
+            for f in TET_FACES {
+                let k = [s[f[0]], s[f[1]], s[f[2]]];
+                if k.contains(&u32::MAX) {
+                    continue;
+                }
+                if let Some(&poor) = triangles.get(&sorted3(k)) {
+                    place = Placement::Face;
+                    is_forced |= poor;
+                }
+            }
+        }
+        if n_surf >= 2 && !is_forced {
+            // An input edge of the tet at which the surface folds sharply on the tet's side: the
+            // tet lies inside the wedge, so its own dihedral angle there is at most the wedge's.
+            let c = mesh.corners(t);
+            let angles = dihedral_angles(&c);
+            for (e, &[i, j]) in TET_EDGES.iter().enumerate() {
+                let (a, b) = (s[i], s[j]);
+                if a == u32::MAX || b == u32::MAX {
+                    continue;
+                }
+                let Some(uses) = edges.get(&[a.min(b), a.max(b)]) else {
+                    continue;
+                };
+                if uses.len() >= 2 && angles[e].to_degrees() < threshold_deg {
+                    // The tet's own angle at an input edge is below the threshold; it is forced
+                    // when the surface's wedge there (on the tet's side) is below it too.
+                    if wedge_below(surface, uses, &c, i, j, threshold_deg) {
+                        is_forced = true;
+                        break;
+                    }
+                }
+            }
+        }
+        placement.push(place);
+        forced.push(is_forced);
+    }
+    Forcing { placement, forced }
+}
+
+/// Whether the surface triangles at an edge `(c[i], c[j])` form, around the tet, a wedge whose
+/// angle is below the threshold: the two triangles nearest the tet on either side enclose it.
+fn wedge_below(
+    surface: &SurfaceMesh,
+    uses: &[(u32, u32)],
+    c: &[[f64; 3]; 4],
+    i: usize,
+    j: usize,
+    threshold_deg: f64,
+) -> bool {
+    let (a, b) = (c[i], c[j]);
+    let axis = sub(b, a);
+    let len = norm(axis);
+    if len == 0.0 {
+        return false;
+    }
+    let axis = axis.map(|x| x / len);
+    // Angle around the edge of a point, from a reference direction.
+    let perp = |p: [f64; 3]| {
+        let d = sub(p, a);
+        let along = dot(d, axis);
+        sub(d, axis.map(|x| x * along))
+    };
+    let others: Vec<usize> = (0..4).filter(|&k| k != i && k != j).collect();
+    let mid = {
+        let (p, q) = (c[others[0]], c[others[1]]);
+        perp([0, 1, 2].map(|k| (p[k] + q[k]) / 2.0))
+    };
+    let r0 = mid;
+    let r1 = cross(axis, r0);
+    let angle = |p: [f64; 3]| {
+        let d = perp(p);
+        dot(d, r1).atan2(dot(d, r0))
+    };
+    // The tet's middle direction is angle 0; the nearest triangle on each side bounds the wedge.
+    let mut lo = -std::f64::consts::PI;
+    let mut hi = std::f64::consts::PI;
+    for &(_, opp) in uses {
+        let th = angle(surface.points[opp as usize]);
+        if th < 0.0 {
+            lo = lo.max(th);
+        } else {
+            hi = hi.min(th);
+        }
+    }
+    (hi - lo).to_degrees() < threshold_deg
+}
+
+/// Summarise a classification with the tets' smallest dihedral angles.
+pub fn summarise(mesh: &TetMesh, f: &Forcing, threshold_deg: f64) -> ForcingSummary {
+    let mut s = ForcingSummary {
+        threshold_deg,
+        ..ForcingSummary::default()
+    };
+    for t in 0..mesh.tets.len() {
+        let m = dihedral_angles(&mesh.corners(t))
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min)
+            .to_degrees();
+        let slot = match f.placement[t] {
+            Placement::Face => {
+                s.n_face += 1;
+                0
+            }
+            Placement::Vertex => {
+                s.n_vertex += 1;
+                1
+            }
+            Placement::Interior => {
+                s.n_interior += 1;
+                2
+            }
+        };
+        if m < 10.0 {
+            s.dihedral_lt_10_by_placement[slot] += 1;
+        }
+        if f.forced[t] {
+            s.n_forced += 1;
+            s.n_forced_dihedral_lt_10 += usize::from(m < 10.0);
+        } else {
+            s.n_unforced_dihedral_lt_5 += usize::from(m < 5.0);
+            s.n_unforced_dihedral_lt_10 += usize::from(m < 10.0);
+            s.n_unforced_dihedral_lt_20 += usize::from(m < 20.0);
+            s.unforced_min_dihedral_deg = Some(s.unforced_min_dihedral_deg.map_or(m, |x| x.min(m)));
+        }
+    }
+    s
+}

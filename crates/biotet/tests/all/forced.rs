@@ -1,0 +1,64 @@
+//! Forced tets: poor because the input surface makes them so.
+
+use crate::common::{cube_surface, cube6, load_stl};
+use biotet::SurfaceMesh;
+use biotet::TetMesh;
+use biotet::quality::forced::{Placement, classify, summarise};
+
+#[test]
+fn a_good_cube_has_no_forced_tets() {
+    let m = cube6();
+    let s = cube_surface([0.0; 3], 1.0);
+    let f = classify(&m, &s, 10.0);
+    assert!(f.forced.iter().all(|&x| !x));
+    // Every Kuhn tet of the cube has a boundary face.
+    assert!(f.placement.iter().all(|&p| p == Placement::Face));
+    let sum = summarise(&m, &f, 10.0);
+    assert_eq!(sum.n_face, 6);
+    assert_eq!(sum.n_unforced_dihedral_lt_10, 0);
+}
+
+#[test]
+fn a_needle_triangle_and_a_sharp_fold_force_their_tets() {
+    // One tet whose face 0-1-2 has a 2.9° angle at vertex 2, and the surface is the tet itself.
+    let p = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.5, 10.0, 0.0],
+        [0.5, 0.3, 1.0],
+    ];
+    let mut tets = vec![[0u32, 1, 2, 3]];
+    crate::common::orient_all(&p, &mut tets);
+    let m = TetMesh::new(p.clone(), tets.clone(), vec![1]);
+    let faces: Vec<[u32; 3]> = (0..4).map(|f| m.face(0, f)).collect();
+    let s = SurfaceMesh::closed(p, faces, 1);
+    let f = classify(&m, &s, 10.0);
+    assert_eq!(f.forced, vec![true]);
+    assert_eq!(f.placement, vec![Placement::Face]);
+    // With a threshold below the needle's angle, nothing is forced by the triangle, and the fold
+    // angles at the tet's edges (its own dihedral angles) are all above 2°.
+    let f = classify(&m, &s, 2.0);
+    assert_eq!(f.forced, vec![false]);
+}
+
+#[test]
+fn the_tetgen_brain_mesh_has_forced_tets_from_marching_cubes() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/brain_tetgen.node"
+    );
+    let m = biotet_io::read_tet_mesh(std::path::Path::new(path))
+        .unwrap()
+        .mesh;
+    let s = load_stl("brain_20k.stl");
+    let f = classify(&m, &s, 10.0);
+    let sum = summarise(&m, &f, 10.0);
+    // About 9% of brain_20k's triangles have an angle under 10° (tests/data/README): TetGen keeps
+    // them all as faces, so their tets are forced.
+    assert!(sum.n_forced > 1000, "{sum:?}");
+    assert_eq!(sum.n_face + sum.n_vertex + sum.n_interior, m.tets.len());
+    assert!(sum.n_forced_dihedral_lt_10 > 0);
+    // Forced tets are a minority of the poor ones: TetGen leaves unforced slivers too.
+    assert!(sum.n_unforced_dihedral_lt_10 > 0, "{sum:?}");
+    assert!(sum.n_forced < sum.n_face + sum.n_vertex, "{sum:?}");
+}
