@@ -2,7 +2,7 @@
 
 use crate::{Common, plot, progress::Stage};
 use anyhow::{Context, Result, bail};
-use biotet::SurfaceMesh;
+use biotet::mesh::shells::{Part, assemble};
 use biotet::mesh::validate::{ValidateOptions, validate_surface};
 use biotet::pipeline::{PipelineOptions, mesh_surface};
 use biotet::quality::{QualityReport, forced};
@@ -31,9 +31,15 @@ enum ZoneArg {
 #[derive(clap::Args)]
 #[command(group(clap::ArgGroup::new("sizing").args(["size", "size_from_surface", "size_field"])))]
 pub struct Args {
-    /// Closed surface (.stl, .obj, .off, .ply, .mesh, .vtu). Without one, the bundled brain
-    /// example is meshed.
+    /// Closed surfaces (.stl, .obj, .off, .ply, .mesh, .vtu). Every closed shell encloses a
+    /// region; a point belongs to the innermost shell around it. Shells are labelled 1, 2, … in
+    /// order of files and of shells within a file, unless --label says otherwise. Without a
+    /// surface, the bundled brain example is meshed.
     surfaces: Vec<PathBuf>,
+    /// Labels of one file's shells in order, as FILE=N[,N...] (repeatable); 0 makes a shell a
+    /// cavity (not meshed).
+    #[arg(long, value_name = "FILE=N[,N...]")]
+    label: Vec<String>,
     /// Output tet mesh (.vtu, .mesh, .msh, .node/.ele). Without it, the mesh is built and
     /// reported only.
     #[arg(short, long, value_name = "OUT")]
@@ -90,6 +96,23 @@ pub struct Args {
     common: Common,
 }
 
+/// `--label FILE=N[,N...]` as labels per input file.
+fn parse_labels(items: &[String], files: &[PathBuf]) -> Result<Vec<Option<Vec<u32>>>> {
+    let mut out = vec![None; files.len()];
+    for item in items {
+        let (f, l) = item
+            .rsplit_once('=')
+            .with_context(|| format!("--label {item}: expected FILE=N[,N...]"))?;
+        let i = files
+            .iter()
+            .position(|p| p.as_os_str() == f || p.file_name().is_some_and(|n| n == f))
+            .with_context(|| format!("--label {item}: {f} is not one of the input surfaces"))?;
+        let v: Result<Vec<u32>, _> = l.split(',').map(|x| x.trim().parse::<u32>()).collect();
+        out[i] = Some(v.with_context(|| format!("--label {item}: bad label"))?);
+    }
+    Ok(out)
+}
+
 fn parse_region_sizes(items: &[String]) -> Result<Vec<(u32, f64)>> {
     items
         .iter()
@@ -112,29 +135,56 @@ fn parse_region_sizes(items: &[String]) -> Result<Vec<(u32, f64)>> {
 
 /// Run `biotet mesh`.
 pub fn run(a: Args) -> Result<ExitCode> {
-    if a.surfaces.len() > 1 {
-        bail!(
-            "several surfaces given; give one file holding every shell (nested shells become \
-             regions), or mesh them one at a time"
-        );
-    }
     let clock = Instant::now();
     let stage = Stage::start(a.common.quiet, "reading the surface");
-    let (mut surface, name): (SurfaceMesh, String) = match a.surfaces.first() {
-        Some(p) => (biotet_io::read_surface(p)?.mesh, p.display().to_string()),
-        None => (
-            biotet_io::stl::parse(EXAMPLE, EXAMPLE_NAME)?.mesh,
-            EXAMPLE_NAME.to_string(),
-        ),
+    let labels = parse_labels(&a.label, &a.surfaces)?;
+    let mut parts = Vec::new();
+    let name = if a.surfaces.is_empty() {
+        parts.push(Part {
+            surface: biotet_io::stl::parse(EXAMPLE, EXAMPLE_NAME)?.mesh,
+            labels: None,
+        });
+        EXAMPLE_NAME.to_string()
+    } else {
+        for (i, p) in a.surfaces.iter().enumerate() {
+            parts.push(Part {
+                surface: biotet_io::read_surface(p)?.mesh,
+                labels: labels[i].clone(),
+            });
+        }
+        a.surfaces
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(" + ")
     };
     stage.set("validating the surface");
-    let validation = validate_surface(&mut surface, &ValidateOptions::default())
+    let (mut surface, shells) =
+        assemble(parts).with_context(|| format!("{name}: cannot assemble the surfaces"))?;
+    validate_surface(&mut surface, &ValidateOptions::default())
         .with_context(|| format!("{name}: invalid surface"))?;
-    if validation.flipped_inward && !a.common.quiet && !a.common.json {
-        eprintln!(
-            "note: {name}: {} of {} triangles faced inward and were flipped",
-            validation.n_flipped_triangles, validation.n_triangles
-        );
+    if !a.common.quiet && !a.common.json {
+        for (k, sh) in shells.iter().enumerate() {
+            if sh.flipped {
+                eprintln!(
+                    "note: {}: shell {k} ({} triangles) faced inward and was flipped",
+                    a.surfaces
+                        .get(sh.part)
+                        .map_or(name.clone(), |p| p.display().to_string()),
+                    sh.n_triangles
+                );
+            }
+        }
+        if shells.len() > 1 {
+            let desc: Vec<String> = shells
+                .iter()
+                .map(|sh| match sh.parent {
+                    Some(p) => format!("{} (inside {})", sh.label, shells[p].label),
+                    None => sh.label.to_string(),
+                })
+                .collect();
+            eprintln!("note: {} shells, regions {}", shells.len(), desc.join(", "));
+        }
     }
     let seconds_read = clock.elapsed().as_secs_f64();
     // Restart the peak-memory count so it measures meshing, not reading and validating (Linux).

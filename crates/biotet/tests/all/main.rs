@@ -6,6 +6,7 @@ mod delaunay;
 mod forced;
 mod predicates;
 mod quality;
+mod shells;
 mod sizing_grid;
 mod template;
 mod validate;

@@ -1,0 +1,310 @@
+//! Several closed surfaces to one labelled surface: each closed shell encloses a region, and the
+//! region of a point is the label of the innermost shell containing it.
+//!
+//! Shells are the connected components of the input triangles (through shared edges). Each is
+//! oriented outward on its own (by its signed volume), then nested by exact point location
+//! ([`RegionLocator`]). A shell's triangles get `sides = [own label, label of the shell around
+//! it]` (0 when none). Two sibling shells that share triangles (touching tissues) keep one copy
+//! of each shared triangle, an interface `[label A, label B]`. A shell labelled 0 is a cavity: its
+//! inside is not meshed.
+//!
+//! Limits: shells touching only along an edge or at a vertex (without a shared triangle) join
+//! into one component; a shell sharing triangles with the shell around it is refused.
+//! [`crate::mesh::validate`] checks the result (closed regions, no intersections).
+
+use rustc_hash::FxHashMap;
+
+use crate::geom::vec3::volume6;
+use crate::mesh::inside::{Location, RegionLocator};
+use crate::mesh::surface::SurfaceMesh;
+
+/// One shell of an assembled surface.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Shell {
+    /// Which input part it came from.
+    pub part: usize,
+    /// Its label (the region it encloses; 0 = a cavity).
+    pub label: u32,
+    /// Triangles.
+    pub n_triangles: usize,
+    /// Index of the innermost shell around it.
+    pub parent: Option<usize>,
+    /// Whether it was reversed to face outward.
+    pub flipped: bool,
+}
+
+/// Why the shells cannot be assembled.
+#[derive(Debug, thiserror::Error)]
+pub enum AssembleError {
+    /// Fewer labels than shells in an input part.
+    #[error("part {part} has {shells} closed shells but {labels} labels were given")]
+    Labels {
+        /// The part.
+        part: usize,
+        /// Its shells.
+        shells: usize,
+        /// Labels given.
+        labels: usize,
+    },
+    /// A shell has the same label as the shell around it.
+    #[error("shell {shell} (part {part}) has label {label}, the same as the shell around it")]
+    SameAsParent {
+        /// Shell index.
+        shell: usize,
+        /// Its part.
+        part: usize,
+        /// The label.
+        label: u32,
+    },
+    /// A shell shares triangles with the shell around it.
+    #[error(
+        "shell {inner} shares triangles with shell {outer} around it (a region touching the \
+         boundary of the region that contains it is not supported yet)"
+    )]
+    SharedWithParent {
+        /// Inner shell.
+        inner: usize,
+        /// Outer shell.
+        outer: usize,
+    },
+}
+
+/// An input part: a surface and optional labels for its shells in order (default: the next
+/// unused labels 1, 2, … in order of parts and shells).
+pub struct Part {
+    /// The triangles (any orientation per shell, consistent within a shell).
+    pub surface: SurfaceMesh,
+    /// Labels of its shells in order of first triangle.
+    pub labels: Option<Vec<u32>>,
+}
+
+#[inline]
+fn key(p: &[f64; 3]) -> [u64; 3] {
+    p.map(|c| if c == 0.0 { 0 } else { c.to_bits() })
+}
+
+/// Connected components of triangles through shared edges: component of each triangle, count.
+fn components(tris: &[[u32; 3]]) -> (Vec<u32>, usize) {
+    let mut parent: Vec<u32> = (0..tris.len() as u32).collect();
+    fn find(p: &mut [u32], mut x: u32) -> u32 {
+        while p[x as usize] != x {
+            p[x as usize] = p[p[x as usize] as usize];
+            x = p[x as usize];
+        }
+        x
+    }
+    let mut first: FxHashMap<(u32, u32), u32> = Default::default();
+    for (t, tri) in tris.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            let e = (a.min(b), a.max(b));
+            match first.get(&e) {
+                Some(&u) => {
+                    let (x, y) = (find(&mut parent, u), find(&mut parent, t as u32));
+                    if x != y {
+                        parent[x.max(y) as usize] = x.min(y);
+                    }
+                }
+                None => {
+                    first.insert(e, t as u32);
+                }
+            }
+        }
+    }
+    let mut id = vec![u32::MAX; tris.len()];
+    let mut comp = vec![0u32; tris.len()];
+    let mut n = 0;
+    for t in 0..tris.len() {
+        let r = find(&mut parent, t as u32) as usize;
+        if id[r] == u32::MAX {
+            id[r] = n;
+            n += 1;
+        }
+        comp[t] = id[r];
+    }
+    (comp, n as usize)
+}
+
+/// Assemble parts into one surface with region labels; returns it and its shells.
+pub fn assemble(parts: Vec<Part>) -> Result<(SurfaceMesh, Vec<Shell>), AssembleError> {
+    // One welded point set.
+    let mut points: Vec<[f64; 3]> = Vec::new();
+    let mut index: FxHashMap<[u64; 3], u32> = Default::default();
+    // Shell triangles, per shell, in its part's numbering mapped to global points.
+    let mut shell_tris: Vec<Vec<[u32; 3]>> = Vec::new();
+    let mut shells: Vec<Shell> = Vec::new();
+    let mut next_label = 1u32;
+    for (pi, part) in parts.iter().enumerate() {
+        let map: Vec<u32> = part
+            .surface
+            .points
+            .iter()
+            .map(|p| {
+                *index.entry(key(p)).or_insert_with(|| {
+                    points.push(*p);
+                    (points.len() - 1) as u32
+                })
+            })
+            .collect();
+        let (comp, n) = components(&part.surface.triangles);
+        if let Some(l) = &part.labels
+            && l.len() != n
+        {
+            return Err(AssembleError::Labels {
+                part: pi,
+                shells: n,
+                labels: l.len(),
+            });
+        }
+        let base = shell_tris.len();
+        for c in 0..n {
+            let label = match &part.labels {
+                Some(l) => l[c],
+                None => next_label,
+            };
+            next_label = next_label.max(label + 1);
+            shells.push(Shell {
+                part: pi,
+                label,
+                n_triangles: 0,
+                parent: None,
+                flipped: false,
+            });
+            shell_tris.push(Vec::new());
+        }
+        for (t, tri) in part.surface.triangles.iter().enumerate() {
+            shell_tris[base + comp[t] as usize].push(tri.map(|v| map[v as usize]));
+        }
+    }
+    // Orient each shell outward by its signed volume (a sign on a closed embedded shell; the
+    // validation that follows confirms the shell is one).
+    for (s, tris) in shell_tris.iter_mut().enumerate() {
+        let o = points[tris[0][0] as usize];
+        let vol: f64 = tris
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|v| points[v as usize]);
+                volume6(o, a, b, c)
+            })
+            .sum();
+        if vol < 0.0 {
+            for t in tris.iter_mut() {
+                t.swap(1, 2);
+            }
+            shells[s].flipped = true;
+        }
+        shells[s].n_triangles = tris.len();
+    }
+    // Shared triangles between shells (by vertex set).
+    let sorted = |t: &[u32; 3]| {
+        let mut k = *t;
+        k.sort_unstable();
+        k
+    };
+    let mut owner: FxHashMap<[u32; 3], (usize, usize)> = Default::default();
+    let mut shared: Vec<(usize, usize, usize, usize)> = Vec::new(); // (shell a, tri a, shell b, tri b)
+    for (s, tris) in shell_tris.iter().enumerate() {
+        for (t, tri) in tris.iter().enumerate() {
+            match owner.get(&sorted(tri)) {
+                Some(&(s0, t0)) if s0 != s => shared.push((s0, t0, s, t)),
+                _ => {
+                    owner.insert(sorted(tri), (s, t));
+                }
+            }
+        }
+    }
+    // Nesting: shell a inside shell b when a point of a not on b is inside b.
+    let n = shells.len();
+    let mut inside = vec![vec![false; n]; n];
+    if n > 1 {
+        let on_shell: Vec<rustc_hash::FxHashSet<u32>> = shell_tris
+            .iter()
+            .map(|tris| tris.iter().flatten().copied().collect())
+            .collect();
+        for b in 0..n {
+            // Shell b alone, on its own points.
+            let mut local: FxHashMap<u32, u32> = Default::default();
+            let mut pts = Vec::new();
+            let tris: Vec<[u32; 3]> = shell_tris[b]
+                .iter()
+                .map(|t| {
+                    t.map(|v| {
+                        *local.entry(v).or_insert_with(|| {
+                            pts.push(points[v as usize]);
+                            (pts.len() - 1) as u32
+                        })
+                    })
+                })
+                .collect();
+            let sb = SurfaceMesh::closed(pts, tris, 1);
+            let loc = RegionLocator::new(&sb);
+            for a in 0..n {
+                if a == b {
+                    continue;
+                }
+                // A vertex of a off b; shells that share every vertex are siblings or equal.
+                if let Some(&v) = on_shell[a]
+                    .iter()
+                    .filter(|v| !on_shell[b].contains(v))
+                    .min()
+                {
+                    inside[a][b] = loc.locate(points[v as usize]) == Location::Region(1);
+                }
+            }
+        }
+    }
+    for a in 0..n {
+        let depth = |x: usize| (0..n).filter(|&b| inside[x][b]).count();
+        let d = depth(a);
+        shells[a].parent = (0..n).find(|&b| inside[a][b] && depth(b) + 1 == d);
+    }
+    for &(a, _, b, _) in &shared {
+        if inside[a][b] {
+            return Err(AssembleError::SharedWithParent { inner: a, outer: b });
+        }
+        if inside[b][a] {
+            return Err(AssembleError::SharedWithParent { inner: b, outer: a });
+        }
+    }
+    for (s, sh) in shells.iter().enumerate() {
+        if let Some(p) = sh.parent
+            && shells[p].label == sh.label
+        {
+            return Err(AssembleError::SameAsParent {
+                shell: s,
+                part: sh.part,
+                label: sh.label,
+            });
+        }
+    }
+    let outside = |s: usize| shells[s].parent.map_or(0, |p| shells[p].label);
+    let mut skip: rustc_hash::FxHashSet<(usize, usize)> = Default::default();
+    let mut interface: FxHashMap<(usize, usize), u32> = Default::default();
+    for &(a, ta, b, tb) in &shared {
+        skip.insert((b, tb));
+        interface.insert((a, ta), shells[b].label);
+    }
+    let mut triangles = Vec::new();
+    let mut sides = Vec::new();
+    for (s, tris) in shell_tris.iter().enumerate() {
+        for (t, tri) in tris.iter().enumerate() {
+            if skip.contains(&(s, t)) {
+                continue;
+            }
+            let front = interface
+                .get(&(s, t))
+                .copied()
+                .unwrap_or_else(|| outside(s));
+            triangles.push(*tri);
+            sides.push([shells[s].label, front]);
+        }
+    }
+    Ok((
+        SurfaceMesh {
+            points,
+            triangles,
+            sides,
+        },
+        shells,
+    ))
+}
