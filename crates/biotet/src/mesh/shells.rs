@@ -114,13 +114,13 @@ fn components(tris: &[[u32; 3]]) -> (Vec<u32>, usize) {
     let mut id = vec![u32::MAX; tris.len()];
     let mut comp = vec![0u32; tris.len()];
     let mut n = 0;
-    for t in 0..tris.len() {
+    for (t, c) in comp.iter_mut().enumerate() {
         let r = find(&mut parent, t as u32) as usize;
         if id[r] == u32::MAX {
             id[r] = n;
             n += 1;
         }
-        comp[t] = id[r];
+        *c = id[r];
     }
     (comp, n as usize)
 }
