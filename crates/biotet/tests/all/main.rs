@@ -6,5 +6,6 @@ mod delaunay;
 mod predicates;
 mod quality;
 mod sizing_grid;
+mod smooth;
 mod template;
 mod validate;
