@@ -4,7 +4,7 @@
 //! For each movable node, its cluster is the tets around it and Φ(x) the smallest solid angle of
 //! the cluster (at every corner, not only at the node) as a function of the node's position
 //! (eq. 4.7). `node` raises Φ along the analytic gradient (eq. 4.8; [`gradient`]), or, when
-//! several angles are nearly tied, along the ascent direction of all of them (`ascent`).
+//! several angles are nearly tied, along the ascent direction of all of them ([`ascent`]).
 //! A sweep visits the movable nodes worst cluster first, Gauss–Seidel style (each node sees its
 //! neighbours' new positions); sweeps repeat until the smallest solid angle of the tets that can
 //! change stops rising, the largest displacement falls below a fraction of the smallest edge, or
