@@ -46,6 +46,8 @@ enum Command {
     /// removal (and the later stages as they land). Without a surface, meshes the bundled
     /// brain example.
     Mesh(cmd::mesh::Args),
+    /// Raise the smallest solid angles of a tet mesh by moving nodes (surface fixed or sliding).
+    Smooth(cmd::smooth::Args),
     /// Validate closed surfaces: closed, manifold, consistently oriented, no self-intersection.
     Validate(cmd::validate::Args),
 }
@@ -66,6 +68,7 @@ fn main() -> ExitCode {
         Command::Validate(a) => cmd::validate::run(a),
         Command::Delaunay(a) => cmd::delaunay::run(a),
         Command::Mesh(a) => cmd::mesh::run(a),
+        Command::Smooth(a) => cmd::smooth::run(a),
     };
     match result {
         Ok(code) => code,

@@ -169,6 +169,197 @@ pub fn write_tri_quality_svg(report: &TriQualityReport, path: &Path, title: &str
     write_svg(path, title, [&angles, &min_angles])
 }
 
+/// Draw the dihedral- and solid-angle histograms of a mesh before and after smoothing, overlaid
+/// (before as a grey outline, after as filled bars; dissertation figs. 4.8 and 4.9) to an SVG
+/// file at `path` (written to a temporary file next to it, then renamed).
+/// `below_02` is the share of solid angles under 0.2 sr before and after.
+pub fn write_smooth_svg(
+    before: &QualityReport,
+    after: &QualityReport,
+    below_02: (f64, f64),
+    path: &Path,
+    title: &str,
+) -> Result<()> {
+    let regular_dihedral = (1.0f64 / 3.0).acos().to_degrees();
+    let dihedral = Overlay {
+        caption: "Dihedral angles before and after (10° bins)".into(),
+        x_desc: "dihedral angle (degrees)",
+        before: &before.dihedral_histogram,
+        after: &after.dihedral_histogram,
+        x_range: (0.0, 180.0),
+        x_step: 20.0,
+        reference: (regular_dihedral, format!("regular {regular_dihedral:.2}°")),
+        notes: vec![
+            format!(
+                "min {} → {}   max {} → {}",
+                deg(before.min_dihedral_deg),
+                deg(after.min_dihedral_deg),
+                deg(before.max_dihedral_deg),
+                deg(after.max_dihedral_deg)
+            ),
+            format!(
+                "tets with min dihedral <10°: {} → {}   <20°: {} → {}",
+                before.n_dihedral_lt_10,
+                after.n_dihedral_lt_10,
+                before.n_dihedral_lt_20,
+                after.n_dihedral_lt_20
+            ),
+        ],
+    };
+    let hb = &before.solid_angle_histogram;
+    let ha = &after.solid_angle_histogram;
+    let last = [hb, ha]
+        .iter()
+        .filter_map(|h| h.occupied().map(|o| h.bin_hi(*o.end())))
+        .fold(0.0, f64::max);
+    let x_hi = (last.max(1.0) * 2.0).ceil() / 2.0;
+    let solid = Overlay {
+        caption: "Solid angles before and after (0.05 sr bins)".into(),
+        x_desc: "solid angle (steradians)",
+        before: hb,
+        after: ha,
+        x_range: (0.0, x_hi),
+        x_step: if x_hi > 3.0 { 0.5 } else { 0.25 },
+        reference: (
+            REGULAR_SOLID_ANGLE,
+            format!("regular {REGULAR_SOLID_ANGLE:.4} sr"),
+        ),
+        notes: vec![
+            format!(
+                "min {} → {}",
+                sr(before.min_solid_angle_sr),
+                sr(after.min_solid_angle_sr)
+            ),
+            format!(
+                "share of solid angles < 0.2 sr: {:.2}% → {:.2}%",
+                100.0 * below_02.0,
+                100.0 * below_02.1
+            ),
+        ],
+    };
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        root.fill(&WHITE)?;
+        let root = root.titled(title, (FONT, 24).into_font().color(&BLACK))?;
+        let (left, right) = root.split_horizontally(SIZE.0 / 2);
+        draw_overlay(&left, &dihedral)?;
+        draw_overlay(&right, &solid)?;
+        root.present()?;
+    }
+    biotet_io::atomic::write_atomic(path, |w| {
+        w.write_all(svg.as_bytes())
+            .map_err(|e| biotet_io::Error::io(&path.display().to_string(), e))
+    })?;
+    Ok(())
+}
+
+/// One panel of [`write_smooth_svg`]: two histograms with the same bins.
+struct Overlay<'a> {
+    caption: String,
+    x_desc: &'a str,
+    before: &'a Histogram,
+    after: &'a Histogram,
+    x_range: (f64, f64),
+    x_step: f64,
+    reference: (f64, String),
+    notes: Vec<String>,
+}
+
+fn draw_overlay(area: &DrawingArea<SVGBackend, Shift>, p: &Overlay) -> Result<()> {
+    let line = 16;
+    let (head, body) = area.split_vertically(34 + line * p.notes.len() as i32);
+    head.draw(&Text::new(
+        p.caption.clone(),
+        (68, 8),
+        (FONT, 18).into_font().color(&BLACK),
+    ))?;
+    for (i, note) in p.notes.iter().enumerate() {
+        head.draw(&Text::new(
+            note.clone(),
+            (68, 32 + line * i as i32),
+            (FONT, 13).into_font().color(&BLACK.mix(0.85)),
+        ))?;
+    }
+    let (x0, x1) = p.x_range;
+    let peak = [p.before, p.after]
+        .iter()
+        .flat_map(|h| h.counts.iter().copied())
+        .max()
+        .unwrap_or(0)
+        .max(1) as f64;
+    let y_hi = peak * 1000.0;
+    let mut chart = ChartBuilder::on(&body)
+        .margin(12)
+        .margin_top(4)
+        .x_label_area_size(44)
+        .y_label_area_size(56)
+        .build_cartesian_2d(x0..x1, (FLOOR..y_hi).log_scale())?;
+    let n_x_labels = ((x1 - x0) / p.x_step).round() as usize + 1;
+    chart
+        .configure_mesh()
+        .disable_x_mesh()
+        .x_labels(n_x_labels)
+        .y_labels(12)
+        .x_label_formatter(&|x| {
+            let s = format!("{x:.2}");
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        })
+        .y_label_formatter(&|y| count_label(*y))
+        .x_desc(p.x_desc)
+        .y_desc("count (log scale)")
+        .label_style((FONT, 13))
+        .axis_desc_style((FONT, 14))
+        .light_line_style(WHITE)
+        .bold_line_style(BLACK.mix(0.12))
+        .draw()?;
+    let bars = |h: &Histogram| -> Vec<[(f64, f64); 2]> {
+        (0..h.counts.len())
+            .filter_map(|i| {
+                let (lo, hi, c) = (h.bin_lo(i), h.bin_hi(i), h.counts[i]);
+                (c > 0 && lo < x1).then_some([(lo, FLOOR), (hi.min(x1), c as f64)])
+            })
+            .collect()
+    };
+    chart
+        .draw_series(
+            bars(p.after)
+                .into_iter()
+                .map(|r| Rectangle::new(r, BAR.mix(0.6).filled())),
+        )?
+        .label(format!("after ({} values)", p.after.total()))
+        .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], BAR.mix(0.6).filled()));
+    let grey = RGBColor(60, 60, 60);
+    chart
+        .draw_series(
+            bars(p.before)
+                .into_iter()
+                .map(|r| Rectangle::new(r, grey.stroke_width(2))),
+        )?
+        .label(format!("before ({} values)", p.before.total()))
+        .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], grey.stroke_width(2)));
+    let (rx, rl) = (&p.reference.0, &p.reference.1);
+    if *rx >= x0 && *rx <= x1 {
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(*rx, FLOOR), (*rx, y_hi)],
+                6,
+                4,
+                REFERENCE.stroke_width(2),
+            ))?
+            .label(rl.clone())
+            .legend(|(x, y)| PathElement::new([(x, y), (x + 14, y)], REFERENCE.stroke_width(2)));
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .label_font((FONT, 12))
+        .background_style(WHITE)
+        .border_style(BLACK.mix(0.4))
+        .draw()?;
+    Ok(())
+}
+
 /// `x` with `prec` decimals, more for a small value (three significant digits), scientific
 /// below 0.001.
 fn num(x: f64, prec: usize) -> String {

@@ -600,3 +600,98 @@ fn mesh_sizing_options() {
         assert!(stderr(&out).contains(needle), "{args:?}: {}", stderr(&out));
     }
 }
+
+// ------------------------------------------------------------------------------------------------
+// biotet smooth
+// ------------------------------------------------------------------------------------------------
+
+#[test]
+fn smooth_fixed_keeps_the_surface_and_raises_the_low_end() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("smooth.vtu");
+    let svg = dir.path().join("smooth.svg");
+    let run = biotet(&[
+        "smooth",
+        s(&example()),
+        "-o",
+        s(&out),
+        "--svg",
+        s(&svg),
+        "--json",
+    ]);
+    let j = json_of(&run);
+    assert_eq!(j["boundary"], "fixed");
+    assert_eq!(j["max_surface_distance"], 0.0);
+    assert!(j["sweeps"].as_u64().unwrap() >= 1);
+    assert!(j["nodes_moved"].as_u64().unwrap() > 1000);
+    assert!(j["seconds_per_sweep"].as_f64().unwrap() > 0.0);
+    let (qb, qa) = (&j["quality_before"], &j["quality_after"]);
+    assert!(
+        qa["min_solid_angle_sr"].as_f64().unwrap() >= qb["min_solid_angle_sr"].as_f64().unwrap()
+    );
+    assert!(qa["n_dihedral_lt_10"].as_u64().unwrap() < qb["n_dihedral_lt_10"].as_u64().unwrap());
+    assert_eq!(qa["n_tets"], qb["n_tets"]);
+    let share = &j["share_solid_below_0_2_sr"];
+    assert!(share["after"].as_f64().unwrap() < share["before"].as_f64().unwrap());
+    // The output is valid and still holds every input triangle exactly.
+    let check = biotet(&["check", s(&out), "-s", s(&brain_surface()), "--quiet"]);
+    assert!(check.status.success(), "{}", stderr(&check));
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.contains("<svg") && text.contains("before") && text.contains("after"));
+    assert!(text.contains("0.2 sr"));
+}
+
+#[test]
+fn smooth_slide_stays_on_the_surface_and_is_deterministic() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("a.vtu"), dir.path().join("b.vtu"));
+    for out in [&a, &b] {
+        let run = biotet(&[
+            "smooth",
+            s(&example()),
+            "--boundary",
+            "slide",
+            "--surface",
+            s(&brain_surface()),
+            "--max-sweeps",
+            "2",
+            "-o",
+            s(out),
+            "--json",
+        ]);
+        let j = json_of(&run);
+        assert_eq!(j["boundary"], "slide");
+        assert!(j["sweeps"].as_u64().unwrap() <= 2);
+        let d = j["max_surface_distance"].as_f64().unwrap();
+        assert!(d < 1e-12, "{d}");
+        assert!(j["smooth"]["n_sliding_nodes"].as_u64().unwrap() > 1000);
+    }
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+    let check = biotet(&["check", s(&a), "--quiet"]);
+    assert!(check.status.success(), "{}", stderr(&check));
+}
+
+#[test]
+fn smooth_errors_name_the_file_and_write_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.vtu");
+    let missing = dir.path().join("missing.vtu");
+    let run = biotet(&["smooth", s(&missing), "-o", s(&out)]);
+    assert_eq!(run.status.code(), Some(2));
+    assert!(stderr(&run).contains("missing.vtu"), "{}", stderr(&run));
+    assert!(!out.exists());
+    let run = biotet(&[
+        "smooth",
+        s(&example()),
+        "--feature-angle",
+        "400",
+        "-o",
+        s(&out),
+    ]);
+    assert_eq!(run.status.code(), Some(2));
+    assert!(stderr(&run).contains("--feature-angle"), "{}", stderr(&run));
+    assert!(!out.exists());
+    let help = biotet(&["smooth", "--help"]);
+    let text = String::from_utf8_lossy(&help.stdout);
+    assert!(help.status.success() && text.contains("--boundary") && text.contains("--json"));
+}

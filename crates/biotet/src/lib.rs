@@ -16,6 +16,7 @@ pub mod pipeline;
 pub mod quality;
 pub mod sizing;
 pub mod sizing_grid;
+pub mod smooth;
 pub mod template;
 
 pub use mesh::surface::SurfaceMesh;

@@ -6,4 +6,5 @@ pub mod delaunay;
 pub mod input;
 pub mod mesh;
 pub mod quality;
+pub mod smooth;
 pub mod validate;

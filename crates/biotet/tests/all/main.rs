@@ -8,5 +8,6 @@ mod predicates;
 mod quality;
 mod shells;
 mod sizing_grid;
+mod smooth;
 mod template;
 mod validate;

@@ -1,0 +1,48 @@
+//! Solid-angle smoothing: one sweep (fixed surface, every movable node visited) over biotet
+//! meshes of the real brain surface at four uniform sizes. The time per tet should stay flat
+//! (dissertation fig. 4.10: time linear in the number of tets).
+//!
+//! `cargo bench -p biotet --bench smooth`; throughput is reported in tets per second.
+
+use biotet::pipeline::{PipelineOptions, mesh_surface};
+use biotet::sizing::Sizing;
+use biotet::smooth::{SmoothOptions, smooth};
+use criterion::{BatchSize, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use std::path::Path;
+use std::time::Duration;
+
+fn bench(c: &mut Criterion) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/brain_20k.stl");
+    let surface = biotet_io::read_surface(&path).expect("brain_20k.stl").mesh;
+    let mut g = c.benchmark_group("smooth");
+    g.sample_size(10);
+    g.warm_up_time(Duration::from_secs(1));
+    let opts = SmoothOptions {
+        max_sweeps: 1,
+        ..SmoothOptions::default()
+    };
+    for h in [4.0, 3.0, 2.5, 2.0] {
+        let sizing = Sizing::uniform(h).expect("size");
+        let (mesh, _) = mesh_surface(&surface, &sizing, &PipelineOptions::default(), &mut |_| {})
+            .expect("mesh");
+        g.throughput(Throughput::Elements(mesh.tets.len() as u64));
+        g.bench_with_input(
+            BenchmarkId::new(
+                "brain_20k_one_sweep",
+                format!("h={h} ({} tets)", mesh.tets.len()),
+            ),
+            &mesh,
+            |b, mesh| {
+                b.iter_batched(
+                    || mesh.clone(),
+                    |mut m| smooth(&mut m, None, &opts).expect("smooth"),
+                    BatchSize::LargeInput,
+                )
+            },
+        );
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -1,0 +1,250 @@
+//! Moving one node: raise the smallest solid angle of the tets around it (its cluster).
+//!
+//! Φ(x) is the minimum of every solid angle of every tet of the cluster — the angles at the
+//! other corners too, which change as the node moves. Each iteration takes the ascent direction
+//! of the angles tied (within a tolerance) for the minimum ([`super::ascent::min_norm_point`] of
+//! their analytic gradients, projected onto the tangent plane when sliding), predicts the step
+//! where the first other angle would catch up with them (linear model, as optimisation-based
+//! smoothers do), capped by a fraction of the cluster's size, and halves the step until Φ
+//! strictly increases and every tet of the cluster is strictly positive by exact `orient3d`.
+//! It stops when no step improves or after an iteration cap.
+
+use super::ascent::{MAX_ACTIVE, min_norm_point};
+use super::gradient::solid_angle_gradients;
+use super::slide::{Location, SlideSurface};
+use crate::geom::predicates::{Sign, in_exact_range, orient3d};
+use crate::geom::vec3::{add, dot, norm, norm2, scale, sub};
+use crate::quality::tet::{REGULAR_SOLID_ANGLE, solid_angles};
+
+/// How a node may move.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Motion {
+    /// Anywhere (an interior node).
+    Free,
+    /// On the surface, from this location.
+    Slide(Location),
+}
+
+/// Tuning of the local search, from [`super::SmoothOptions`].
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct LocalParams {
+    pub max_iterations: usize,
+    pub active_tolerance: f64,
+    pub step_fraction: f64,
+    pub max_halvings: usize,
+    pub min_sensitivity: f64,
+}
+
+/// Reusable buffers for one node's cluster.
+#[derive(Debug, Default)]
+pub(crate) struct Cluster {
+    /// Corners of each tet of the cluster, the free node's at `local[i]`.
+    corners: Vec<[[f64; 3]; 4]>,
+    local: Vec<usize>,
+    /// The solid angles of each tet at the current position.
+    angles: Vec<[f64; 4]>,
+    trial: Vec<[f64; 4]>,
+    /// Gradients with respect to the free node of each tet's four angles.
+    grads: Vec<[[f64; 3]; 4]>,
+}
+
+/// The result of moving one node.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Moved {
+    pub x: [f64; 3],
+    pub loc: Option<Location>,
+    pub phi_before: f64,
+    pub phi_after: f64,
+}
+
+impl Cluster {
+    /// Load the tets `star` around node `v` of `mesh`.
+    pub fn load(&mut self, points: &[[f64; 3]], tets: &[[u32; 4]], star: &[u32], v: u32) {
+        self.corners.clear();
+        self.local.clear();
+        for &t in star {
+            let tv = tets[t as usize];
+            self.corners.push(tv.map(|i| points[i as usize]));
+            self.local
+                .push(tv.iter().position(|&i| i == v).unwrap_or(0));
+        }
+    }
+
+    /// The cluster's minimum solid angle at the loaded position, `angles` filled.
+    fn measure(&mut self) -> f64 {
+        self.angles.clear();
+        let mut phi = f64::INFINITY;
+        for c in &self.corners {
+            let a = solid_angles(c);
+            phi = phi.min(a[0].min(a[1]).min(a[2]).min(a[3]));
+            self.angles.push(a);
+        }
+        phi
+    }
+
+    /// Φ at `x` into `trial` if it is strictly above `floor`, the cluster's soft measure does not
+    /// fall, and every tet is strictly positive (exact); `None` otherwise.
+    fn try_at(&mut self, x: [f64; 3], floor: f64) -> Option<f64> {
+        if !x.iter().all(|&c| c.is_finite() && in_exact_range(c)) {
+            return None;
+        }
+        self.trial.clear();
+        let mut phi = f64::INFINITY;
+        for (c, &k) in self.corners.iter().zip(&self.local) {
+            let mut c = *c;
+            c[k] = x;
+            let a = solid_angles(&c);
+            let m = a[0].min(a[1]).min(a[2]).min(a[3]);
+            // Also rejects NaN.
+            if m.is_nan() || m <= floor {
+                return None;
+            }
+            phi = phi.min(m);
+            self.trial.push(a);
+        }
+        // The rest of the cluster must not pay for the minimum's gain: the sum of the logarithms
+        // of the angles (each capped at the regular tet's, so that flattening a large angle
+        // counts for nothing) must not fall. Without it, max-min drags the cluster's other
+        // angles down to the minimum and fattens the low end of the histogram.
+        let (mut soft_new, mut soft_old) = (0.0, 0.0);
+        for (new, old) in self.trial.iter().zip(&self.angles) {
+            for i in 0..4 {
+                soft_new += new[i].min(REGULAR_SOLID_ANGLE).ln();
+                soft_old += old[i].min(REGULAR_SOLID_ANGLE).ln();
+            }
+        }
+        if soft_new.is_nan() || soft_new < soft_old {
+            return None;
+        }
+        for (c, &k) in self.corners.iter().zip(&self.local) {
+            let mut c = *c;
+            c[k] = x;
+            if orient3d(c[0], c[1], c[2], c[3]) != Sign::Positive {
+                return None;
+            }
+        }
+        Some(phi)
+    }
+
+    /// Move the free node, starting at `x0`; `None` when it stays where it is.
+    pub fn optimise(
+        &mut self,
+        x0: [f64; 3],
+        motion: Motion,
+        surface: Option<&SlideSurface>,
+        p: &LocalParams,
+    ) -> Option<Moved> {
+        if self.corners.is_empty() {
+            return None;
+        }
+        let phi0 = self.measure();
+        if !phi0.is_finite() {
+            return None;
+        }
+        // The cluster's size: the mean distance to the other corners.
+        let mut size = 0.0;
+        let mut n = 0;
+        for (c, &k) in self.corners.iter().zip(&self.local) {
+            for (i, q) in c.iter().enumerate() {
+                if i != k {
+                    size += norm(sub(*q, x0));
+                    n += 1;
+                }
+            }
+        }
+        let delta_max = p.step_fraction * size / n as f64;
+        let min_step = 1e-9 * delta_max;
+        let (mut x, mut loc, mut phi) = (x0, motion, phi0);
+        let mut active: Vec<(f64, usize, usize)> = Vec::with_capacity(16);
+        let mut g: Vec<[f64; 3]> = Vec::with_capacity(MAX_ACTIVE);
+        for _ in 0..p.max_iterations {
+            // Gradients of every angle (for the active set and the step prediction).
+            self.grads.clear();
+            for (c, &k) in self.corners.iter().zip(&self.local) {
+                let mut c = *c;
+                c[k] = x;
+                self.grads.push(solid_angle_gradients(&c, k).1);
+            }
+            let normal = match (loc, surface) {
+                (Motion::Slide(l), Some(s)) => Some(s.normal(&l)),
+                _ => None,
+            };
+            let tangent = |v: [f64; 3]| match normal {
+                Some(n) => sub(v, scale(n, dot(v, n))),
+                None => v,
+            };
+            let window = phi + p.active_tolerance * phi.abs();
+            active.clear();
+            for (t, a) in self.angles.iter().enumerate() {
+                for (i, &w) in a.iter().enumerate() {
+                    if w <= window {
+                        active.push((w, t, i));
+                    }
+                }
+            }
+            active.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then((a.1, a.2).cmp(&(b.1, b.2))));
+            active.truncate(MAX_ACTIVE);
+            g.clear();
+            g.extend(active.iter().map(|&(_, t, i)| tangent(self.grads[t][i])));
+            let d = min_norm_point(&g);
+            let dd = norm2(d);
+            let gmax = g.iter().map(|x| norm2(*x)).fold(0.0, f64::max);
+            // Stationary, or the minimum barely depends on this node (a tet it cannot repair):
+            // moving it would only trade the cluster's other angles for nothing.
+            if dd.is_nan()
+                || dd <= 1e-20 * gmax
+                || dd.sqrt() * size / (n as f64) < p.min_sensitivity
+            {
+                break;
+            }
+            // Linear model: the active angles rise at least at `rate`; an inactive angle j
+            // rising slower meets them after (ξ_j − Φ) / (rate − g_j·d).
+            let rate = g.iter().map(|x| dot(*x, d)).fold(f64::INFINITY, f64::min);
+            let mut alpha = delta_max / dd.sqrt();
+            for (t, a) in self.angles.iter().enumerate() {
+                for (i, &w) in a.iter().enumerate() {
+                    if w > window {
+                        let r = dot(tangent(self.grads[t][i]), d);
+                        if r < rate {
+                            alpha = alpha.min((w - phi) / (rate - r));
+                        }
+                    }
+                }
+            }
+            let mut accepted = None;
+            for _ in 0..=p.max_halvings {
+                if alpha * dd.sqrt() < min_step {
+                    break;
+                }
+                let step = scale(d, alpha);
+                let cand = match (loc, surface) {
+                    (Motion::Slide(l), Some(s)) => {
+                        s.walk(&l, step).map(|(nl, nx)| (nx, Motion::Slide(nl)))
+                    }
+                    _ => Some((add(x, step), Motion::Free)),
+                };
+                if let Some((nx, nl)) = cand
+                    && let Some(np) = self.try_at(nx, phi)
+                {
+                    accepted = Some((nx, nl, np));
+                    break;
+                }
+                alpha *= 0.5;
+            }
+            let Some((nx, nl, np)) = accepted else { break };
+            x = nx;
+            loc = nl;
+            phi = np;
+            std::mem::swap(&mut self.angles, &mut self.trial);
+        }
+        (x != x0).then_some(Moved {
+            x,
+            loc: match loc {
+                Motion::Slide(l) => Some(l),
+                Motion::Free => None,
+            },
+            phi_before: phi0,
+            phi_after: phi,
+        })
+    }
+}
