@@ -223,6 +223,9 @@ pub fn run(a: Args) -> Result<ExitCode> {
         ZoneArg::Euclidean => Zone::Euclidean,
     };
     opts.deploy.max_voxels = a.max_voxels;
+    if a.no_smooth {
+        opts.smooth = None;
+    }
     let (mesh, report) = mesh_surface(&surface, &sizing, &opts, &mut |s| stage.set(s))
         .with_context(|| name.clone())?;
 
