@@ -1,4 +1,5 @@
-//! The surface-to-mesh pipeline (node deployment, Delaunay, outside removal) on the real brain
+//! The surface-to-mesh pipeline's deployment stages (node deployment, Delaunay, outside removal;
+//! smoothing has its own bench) on the real brain
 //! surface at four uniform sizes, from about 150 thousand to 2.6 million tets: the time per tet
 //! should stay flat (dissertation fig. 2.16: time linear in the number of tets).
 //!
@@ -18,7 +19,7 @@ fn bench(c: &mut Criterion) {
     g.warm_up_time(Duration::from_secs(1));
     for h in [4.0, 3.0, 2.0, 1.5] {
         let sizing = Sizing::uniform(h).expect("size");
-        let opts = PipelineOptions::default();
+        let opts = PipelineOptions::deploy_only();
         let (mesh, _) = mesh_surface(&surface, &sizing, &opts, &mut |_| {}).expect("mesh");
         g.throughput(Throughput::Elements(mesh.tets.len() as u64));
         g.bench_with_input(

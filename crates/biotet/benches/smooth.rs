@@ -23,8 +23,13 @@ fn bench(c: &mut Criterion) {
     };
     for h in [4.0, 3.0, 2.5, 2.0] {
         let sizing = Sizing::uniform(h).expect("size");
-        let (mesh, _) = mesh_surface(&surface, &sizing, &PipelineOptions::default(), &mut |_| {})
-            .expect("mesh");
+        let (mesh, _) = mesh_surface(
+            &surface,
+            &sizing,
+            &PipelineOptions::deploy_only(),
+            &mut |_| {},
+        )
+        .expect("mesh");
         g.throughput(Throughput::Elements(mesh.tets.len() as u64));
         g.bench_with_input(
             BenchmarkId::new(

@@ -25,6 +25,16 @@ pub struct PipelineOptions {
     pub smooth: Option<SmoothOptions>,
 }
 
+impl PipelineOptions {
+    /// Node deployment, Delaunay and outside removal only (no later stage).
+    pub fn deploy_only() -> PipelineOptions {
+        PipelineOptions {
+            smooth: None,
+            ..PipelineOptions::default()
+        }
+    }
+}
+
 impl Default for PipelineOptions {
     fn default() -> PipelineOptions {
         PipelineOptions {

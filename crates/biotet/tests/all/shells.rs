@@ -86,7 +86,8 @@ fn nested_brain_and_white_matter_mesh_into_two_regions() {
         SizingOptions::new(SizeSpec::FromSurface { grading: 0.3 }),
     )
     .unwrap();
-    let (mesh, _) = mesh_surface(&s, &sizing, &PipelineOptions::default(), &mut |_| {}).unwrap();
+    let (mesh, _) =
+        mesh_surface(&s, &sizing, &PipelineOptions::deploy_only(), &mut |_| {}).unwrap();
     let mut vol = [0.0f64; 3];
     for t in 0..mesh.tets.len() {
         vol[mesh.labels[t] as usize] += volume(&mesh.corners(t));

@@ -462,7 +462,8 @@ fn tetgen_brain() -> TetMesh {
 fn biotet_brain(h: f64) -> (SurfaceMesh, TetMesh) {
     let s = load_stl("brain_20k.stl");
     let sizing = Sizing::uniform(h).unwrap();
-    let (mesh, _) = mesh_surface(&s, &sizing, &PipelineOptions::default(), &mut |_| {}).unwrap();
+    let (mesh, _) =
+        mesh_surface(&s, &sizing, &PipelineOptions::deploy_only(), &mut |_| {}).unwrap();
     (s, mesh)
 }
 

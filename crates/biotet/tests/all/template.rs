@@ -240,7 +240,7 @@ fn pipeline_on_the_brain_keeps_the_inside() {
     )
     .unwrap();
     let (mesh, report) =
-        mesh_surface(&s, &sizing, &PipelineOptions::default(), &mut |_| {}).unwrap();
+        mesh_surface(&s, &sizing, &PipelineOptions::deploy_only(), &mut |_| {}).unwrap();
     let c = check(&mesh, None);
     assert!(
         c.n_nonpositive == 0 && c.n_overshared_faces == 0 && c.n_adjacency_errors == 0,
