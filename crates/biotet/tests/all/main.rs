@@ -3,6 +3,7 @@
 mod check;
 mod common;
 mod delaunay;
+mod lastresort;
 mod predicates;
 mod quality;
 mod validate;

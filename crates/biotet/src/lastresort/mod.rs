@@ -1,0 +1,13 @@
+//! LAST RESORT (dissertation chapter 3): fill cavities by exhaustive search, and recover missing
+//! surface triangles of a tet mesh by carving and refilling cavities, without new points on the
+//! surface.
+//!
+//! - [`search`]: Algorithm 3.1, the search that fills a closed cavity shell with tets whose
+//!   corners are cavity points ([`fill`], [`Searcher`]).
+//!
+//! Every combinatorial decision is an exact predicate (orient3d, exact segment–triangle and
+//! triangle–triangle tests); floating point only ranks tets by quality.
+
+pub mod search;
+
+pub use search::{Fill, SearchError, SearchOptions, Searcher, fill};
