@@ -43,6 +43,7 @@ use crate::geom::intersect::{TriTri, is_degenerate, tri_tri};
 use crate::geom::predicates::{Sign, in_exact_range};
 use crate::quality::tet::q_measure;
 use rustc_hash::FxHashMap;
+use std::cell::Cell;
 use thiserror::Error;
 
 type P3 = [f64; 3];
@@ -218,6 +219,27 @@ pub struct Searcher {
     improve: Option<u64>,
     scratch: Vec<[u32; 3]>,
     edges: Vec<(u32, u32)>,
+    /// Cached orientations of every point against every face's plane, face-major
+    /// ([`UNKNOWN`] until computed).
+    sides: Vec<Cell<i8>>,
+    /// Orientations against the three new faces of the current candidate, stamped.
+    raw: Vec<Cell<(u32, i8)>>,
+    raw_stamp: Cell<u32>,
+    /// Per edge of the face whose candidates are computed: the apex of the one other front face
+    /// across it, and that face, when the region's wedge there is convex.
+    wedge: [Option<u32>; 3],
+}
+
+/// Marks a not yet computed entry of `Searcher::sides`.
+const UNKNOWN: i8 = 2;
+
+/// A face plane of a tet, oriented outwards: a front face's (cached, possibly flipped) or a
+/// plain triangle's.
+#[derive(Debug, Clone, Copy)]
+enum Plane {
+    Face(u32, bool),
+    /// A plain triangle, its orientations cached in slot `k` (0..3) of the current candidate.
+    Tri(usize, [u32; 3]),
 }
 
 /// Canonical rotation of an oriented triangle (smallest index first).
@@ -394,6 +416,9 @@ impl Searcher {
         self.front_deg.resize(np, 0);
         self.uses.clear();
         self.uses.resize(np, 0);
+        self.raw.clear();
+        self.raw.resize(3 * np, Cell::new((0, 0)));
+        self.raw_stamp.set(1);
         self.faces.clear();
         self.cands.clear();
         self.map.clear();
@@ -428,6 +453,14 @@ impl Searcher {
         for &x in &v {
             self.front_deg[x as usize] += 1;
         }
+        let np = self.pts.len();
+        let row = id as usize * np;
+        if self.sides.len() < row + np {
+            self.sides.resize_with(row + np, || Cell::new(UNKNOWN));
+        }
+        for c in &self.sides[row..row + np] {
+            c.set(UNKNOWN);
+        }
     }
 
     fn kill_face(&mut self, f: u32) {
@@ -446,29 +479,151 @@ impl Searcher {
         self.front_deg[p as usize] > 0 || self.uses[p as usize] == 0
     }
 
+    /// Exact orientation of point `d` against the plane of `abc`, zero at once when `d` is one
+    /// of `a, b, c` (no adaptive stage for the exact zero).
+    #[inline]
+    fn o(&self, a: u32, b: u32, c: u32, d: u32) -> Sign {
+        if d == a || d == b || d == c {
+            return Sign::Zero;
+        }
+        let p = &self.pts;
+        orient3d(p[a as usize], p[b as usize], p[c as usize], p[d as usize])
+    }
+
+    /// [`Self::o`] against the plane of face `f`, cached per face and point.
+    #[inline]
+    fn side(&self, f: u32, x: u32) -> Sign {
+        let cell = &self.sides[f as usize * self.pts.len() + x as usize];
+        match cell.get() {
+            1 => Sign::Positive,
+            -1 => Sign::Negative,
+            0 => Sign::Zero,
+            _ => {
+                let v = self.faces[f as usize].v;
+                let s = self.o(v[0], v[1], v[2], x);
+                cell.set(s.as_i32() as i8);
+                s
+            }
+        }
+    }
+
+    /// Orientation of `x` against plane `pl`, positive outside the tet.
+    #[inline]
+    fn outer(&self, pl: Plane, x: u32) -> Sign {
+        match pl {
+            Plane::Face(f, flip) => self.side(f, x).times(!flip),
+            Plane::Tri(k, v) => {
+                let cell = &self.raw[k * self.pts.len() + x as usize];
+                let (st, val) = cell.get();
+                if st == self.raw_stamp.get() {
+                    return match val {
+                        1 => Sign::Positive,
+                        -1 => Sign::Negative,
+                        _ => Sign::Zero,
+                    };
+                }
+                let s = self.o(v[0], v[1], v[2], x);
+                cell.set((self.raw_stamp.get(), s.as_i32() as i8));
+                s
+            }
+        }
+    }
+
+    /// Is `other` on the closed outer side of plane `pl` (face `fv`), touching it only at
+    /// corners of `fv`? Then the two meet at most in shared corners of that face.
+    #[inline]
+    fn separates(&self, pl: Plane, fv: [u32; 3], other: &[u32]) -> bool {
+        other.iter().all(|&x| match self.outer(pl, x) {
+            Sign::Positive => true,
+            Sign::Zero => fv.contains(&x),
+            Sign::Negative => false,
+        })
+    }
+
+    /// Do the triangles `f` and `g` (distinct vertex sets) meet other than in shared corners or
+    /// a shared edge? Exact; the plane tests settle the common cases without [`tri_tri`].
+    fn tri_conflict(&self, f: [u32; 3], g: [u32; 3]) -> bool {
+        let one_side = |a: [u32; 3], b: [u32; 3]| {
+            let mut pos = false;
+            let mut neg = false;
+            for &x in &b {
+                if a.contains(&x) {
+                    continue;
+                }
+                match self.o(a[0], a[1], a[2], x) {
+                    Sign::Positive => pos = true,
+                    Sign::Negative => neg = true,
+                    Sign::Zero => return false,
+                }
+            }
+            !(pos && neg)
+        };
+        if one_side(f, g) || one_side(g, f) {
+            return false;
+        }
+        let fp = f.map(|x| self.pts[x as usize]);
+        let gp = g.map(|x| self.pts[x as usize]);
+        stat(0);
+        tri_tri(&fp, &gp) == TriTri::Improper
+    }
+
+    /// The outward planes of the candidate tet `face + p`.
+    #[inline]
+    fn cand_planes(&self, f: u32, p: u32) -> ([[u32; 3]; 4], [Plane; 4]) {
+        self.raw_stamp.set(self.raw_stamp.get().wrapping_add(1));
+        let v = self.faces[f as usize].v;
+        let tf = tet_faces([v[0], v[1], v[2], p]);
+        (
+            tf,
+            [
+                Plane::Tri(0, tf[0]),
+                Plane::Tri(1, tf[1]),
+                Plane::Tri(2, tf[2]),
+                Plane::Face(f, true),
+            ],
+        )
+    }
+
     /// Compute the candidates of face `f` (its range is the end of `cands`).
     fn gen_candidates(&mut self, f: usize) {
         let v = self.faces[f].v;
         let [a, b, c] = v.map(|x| self.pts[x as usize]);
         let start = self.cands.len();
-        for p in 0..self.pts.len() as u32 {
+        self.find_wedges(f as u32);
+        let wedge = self.wedge;
+        'apex: for p in 0..self.pts.len() as u32 {
             if v.contains(&p) || !self.usable(p) {
                 continue;
             }
-            let d = self.pts[p as usize];
-            if orient3d(a, b, c, d) != Sign::Positive {
+            if self.side(f as u32, p) != Sign::Positive {
                 continue;
             }
+            // Convex wedge at an edge: the apex must be in front of the face across it (or be
+            // its apex): else the tet leaves the region next to that edge.
+            for h in wedge.iter().flatten() {
+                let hv = self.faces[*h as usize].v;
+                if !hv.contains(&p) && self.side(*h, p) != Sign::Positive {
+                    continue 'apex;
+                }
+            }
+            let d = self.pts[p as usize];
             let corners = [a, b, c, d];
             let q = q_measure(&corners);
             if (self.eta > 0.0 && !(q > self.eta)) || q <= self.bound {
                 continue;
             }
-            let t = [v[0], v[1], v[2], p];
             let (lo, hi) = bbox4(&corners);
-            if self.contains_point(t, &corners, lo, hi) || self.hits_front(t, f as u32, lo, hi) {
+            let (tf, planes) = self.cand_planes(f as u32, p);
+            let t = [v[0], v[1], v[2], p];
+            stat(1);
+            if self.contains_point(t, &planes, lo, hi) {
                 continue;
             }
+            stat(2);
+            if self.hits_front(t, &tf, &planes, f as u32, lo, hi) {
+                continue;
+            }
+            stat(3);
             self.cands.push(Cand {
                 p,
                 q,
@@ -484,9 +639,48 @@ impl Searcher {
         face.live = face.c1 - face.c0;
     }
 
+    /// For each edge of face `f`, the other front face across it when it is the only one and the
+    /// region's wedge between the two is convex (at most flat).
+    fn find_wedges(&mut self, f: u32) {
+        let v = self.faces[f as usize].v;
+        let mut w = [None; 3];
+        let mut count = [0u8; 3];
+        for (h, face) in self.faces.iter().enumerate() {
+            if !face.alive || h as u32 == f {
+                continue;
+            }
+            let hv = face.v;
+            for k in 0..3 {
+                let (a, b) = (v[k], v[(k + 1) % 3]);
+                // The face across runs the edge backwards.
+                if (0..3).any(|i| hv[i] == b && hv[(i + 1) % 3] == a) {
+                    count[k] += 1;
+                    w[k] = Some(h as u32);
+                }
+                if (0..3).any(|i| hv[i] == a && hv[(i + 1) % 3] == b) {
+                    count[k] += 2;
+                }
+            }
+        }
+        for k in 0..3 {
+            self.wedge[k] = None;
+            if count[k] != 1 {
+                continue;
+            }
+            if let Some(h) = w[k] {
+                let hv = self.faces[h as usize].v;
+                let Some(&apex) = hv.iter().find(|&&x| !v.contains(&x)) else {
+                    continue;
+                };
+                if self.side(f, apex) != Sign::Negative {
+                    self.wedge[k] = Some(h);
+                }
+            }
+        }
+    }
+
     /// Does the closed tet `t` contain a usable point other than its corners?
-    fn contains_point(&self, t: [u32; 4], c: &[P3; 4], lo: P3, hi: P3) -> bool {
-        let faces = tet_faces([0, 1, 2, 3]);
+    fn contains_point(&self, t: [u32; 4], planes: &[Plane; 4], lo: P3, hi: P3) -> bool {
         for r in 0..self.pts.len() as u32 {
             if t.contains(&r) || !self.usable(r) {
                 continue;
@@ -495,43 +689,53 @@ impl Searcher {
             if (0..3).any(|k| x[k] < lo[k] || x[k] > hi[k]) {
                 continue;
             }
-            let inside = faces.iter().all(|fl| {
-                orient3d(c[fl[0] as usize], c[fl[1] as usize], c[fl[2] as usize], x)
-                    != Sign::Positive
-            });
-            if inside {
+            // The base plane first: cached.
+            if planes
+                .iter()
+                .rev()
+                .all(|&pl| self.outer(pl, r) != Sign::Positive)
+            {
                 return true;
             }
         }
         false
     }
 
-    /// Does the tet `t` (built on alive face `base`) meet another active face improperly?
-    fn hits_front(&self, t: [u32; 4], base: u32, lo: P3, hi: P3) -> bool {
-        let tf = tet_faces(t);
+    /// Does the candidate tet `t` (built on alive face `base`) meet another active face
+    /// improperly?
+    fn hits_front(
+        &self,
+        t: [u32; 4],
+        tf: &[[u32; 3]; 4],
+        planes: &[Plane; 4],
+        base: u32,
+        lo: P3,
+        hi: P3,
+    ) -> bool {
         for (g, face) in self.faces.iter().enumerate() {
             if !face.alive || g as u32 == base {
                 continue;
             }
-            if self.face_conflicts(&tf, t, face.v, lo, hi, Some(3)) {
+            if self.face_conflicts(t, tf, planes, g as u32, lo, hi) {
                 return true;
             }
         }
         false
     }
 
-    /// Exact: does triangle `g` meet the tet with faces `tf` (corners `t`) other than in shared
-    /// vertices, edges or whole faces? Faces of the tet equal to `g` (as vertex sets) are
-    /// skipped; so is face `skip` of the tet (the base, already on the front).
+    /// Exact: does front face `gid` meet the candidate tet (corners `t`, outward faces `tf` with
+    /// planes `planes`, the last one its base) other than in shared vertices, edges or whole
+    /// faces?
     fn face_conflicts(
         &self,
-        tf: &[[u32; 3]; 4],
         t: [u32; 4],
-        g: [u32; 3],
+        tf: &[[u32; 3]; 4],
+        planes: &[Plane; 4],
+        gid: u32,
         lo: P3,
         hi: P3,
-        skip: Option<usize>,
     ) -> bool {
+        let g = self.faces[gid as usize].v;
         let gp = g.map(|x| self.pts[x as usize]);
         let mut glo = gp[0];
         let mut ghi = gp[0];
@@ -547,90 +751,55 @@ impl Searcher {
         if tf.iter().any(|f| same_set(*f, g)) {
             return false;
         }
-        // A face plane of the tet with g on its closed outer side, touching only at corners of
-        // that face: contact within shared corners only.
-        for f in tf {
-            let fp = f.map(|x| self.pts[x as usize]);
-            let ok = (0..3).all(|k| match orient3d(fp[0], fp[1], fp[2], gp[k]) {
-                Sign::Positive => true,
-                Sign::Zero => f.contains(&g[k]),
-                Sign::Negative => false,
-            });
-            if ok {
+        stat(4);
+        // g's plane (cached) with the tet on one closed side, touching only at corners of g.
+        let mut pos = false;
+        let mut neg = false;
+        let mut cut = false;
+        for &x in &t {
+            match self.side(gid, x) {
+                Sign::Positive => pos = true,
+                Sign::Negative => neg = true,
+                Sign::Zero => cut |= !g.contains(&x),
+            }
+        }
+        if !cut && !(pos && neg) {
+            return false;
+        }
+        stat(5);
+        // A face plane of the tet with g on its closed outer side.
+        for k in (0..4).rev() {
+            if self.separates(planes[k], tf[k], &g) {
                 return false;
             }
         }
-        // g's plane with the tet on one closed side, touching only at corners of g.
-        let mut side = Sign::Zero;
-        let mut sep = true;
-        for &x in &t {
-            let s = orient3d(gp[0], gp[1], gp[2], self.pts[x as usize]);
-            match s {
-                Sign::Zero => {
-                    if !g.contains(&x) {
-                        sep = false;
-                        break;
-                    }
-                }
-                _ => {
-                    if side == Sign::Zero {
-                        side = s;
-                    } else if side != s {
-                        sep = false;
-                        break;
-                    }
-                }
-            }
-        }
-        if sep {
-            return false;
-        }
-        for (k, f) in tf.iter().enumerate() {
-            if Some(k) == skip {
-                continue;
-            }
-            let fp = f.map(|x| self.pts[x as usize]);
-            if tri_tri(&fp, &gp) == TriTri::Improper {
-                return true;
-            }
-        }
-        false
+        stat(6);
+        tf[..3].iter().any(|f| self.tri_conflict(*f, g))
     }
 
-    /// Do the candidate tet `c` and the new tet `t` overlap or meet improperly?
-    fn tets_conflict(&self, c: [u32; 4], clo: P3, chi: P3, t: [u32; 4], tlo: P3, thi: P3) -> bool {
-        if boxes_apart(clo, chi, tlo, thi) {
-            return false;
-        }
+    /// Do the candidate tet `c` (outward faces `cf`, planes `cp`) and the new tet (faces `tf`,
+    /// planes `tp`) overlap or meet improperly?
+    #[allow(clippy::too_many_arguments)]
+    fn tets_conflict(
+        &self,
+        c: [u32; 4],
+        cf: &[[u32; 3]; 4],
+        cp: &[Plane; 4],
+        t: [u32; 4],
+        tf: &[[u32; 3]; 4],
+        tp: &[Plane; 4],
+    ) -> bool {
         if t.iter().all(|x| c.contains(x)) {
             return true;
         }
-        let cf = tet_faces(c);
-        let tf = tet_faces(t);
-        // Separating face planes (contact at shared corners of that face only).
-        let separated = |faces: &[[u32; 3]; 4], other: [u32; 4]| {
-            faces.iter().any(|f| {
-                let fp = f.map(|x| self.pts[x as usize]);
-                other.iter().all(
-                    |&x| match orient3d(fp[0], fp[1], fp[2], self.pts[x as usize]) {
-                        Sign::Positive => true,
-                        Sign::Zero => f.contains(&x),
-                        Sign::Negative => false,
-                    },
-                )
-            })
-        };
-        if separated(&tf, c) || separated(&cf, t) {
+        if (0..4).any(|k| self.separates(tp[k], tf[k], &c))
+            || (0..4).rev().any(|k| self.separates(cp[k], cf[k], &t))
+        {
             return false;
         }
-        for f in &cf {
-            let fp = f.map(|x| self.pts[x as usize]);
-            for g in &tf {
-                if same_set(*f, *g) {
-                    continue;
-                }
-                let gp = g.map(|x| self.pts[x as usize]);
-                if tri_tri(&fp, &gp) == TriTri::Improper {
+        for f in cf {
+            for g in tf {
+                if !same_set(*f, *g) && self.tri_conflict(*f, *g) {
                     return true;
                 }
             }
@@ -656,40 +825,40 @@ impl Searcher {
         for &x in &t {
             self.uses[x as usize] += 1;
         }
-        let mut fresh = [[0u32; 3]; 3];
-        let mut n_fresh = 0;
-        for g in &tet_faces(t)[..3] {
+        let tf = tet_faces(t);
+        let mut tp = [Plane::Face(fi, true); 4];
+        let first_new = self.faces.len();
+        for k in 0..3 {
+            let g = tf[k];
             let rev = [g[0], g[2], g[1]];
             if let Some(&h) = self.map.get(&canon(rev)) {
                 self.kill_face(h);
+                tp[k] = Plane::Face(h, true);
             } else {
-                fresh[n_fresh] = *g;
-                n_fresh += 1;
+                tp[k] = Plane::Face(self.faces.len() as u32, false);
+                self.push_face(g);
             }
         }
         // Filter the candidates of the other live faces against the new tet.
         let (tlo, thi) = (cand.lo, cand.hi);
-        for f in 0..self.faces.len() {
+        for f in 0..first_new {
             let fr = self.faces[f];
             if !fr.alive || fr.live == 0 {
                 continue;
             }
             for k in fr.c0..fr.c1 {
                 let c = self.cands[k as usize];
-                if c.dead {
+                if c.dead || boxes_apart(c.lo, c.hi, tlo, thi) {
                     continue;
                 }
                 let ct = [fr.v[0], fr.v[1], fr.v[2], c.p];
-                if self.tets_conflict(ct, c.lo, c.hi, t, tlo, thi) {
+                let (cf, cp) = self.cand_planes(f as u32, c.p);
+                if self.tets_conflict(ct, &cf, &cp, t, &tf, &tp) {
                     self.cands[k as usize].dead = true;
                     self.faces[f].live -= 1;
                     self.kill_log.push(k);
                 }
             }
-        }
-        let first_new = self.faces.len();
-        for g in &fresh[..n_fresh] {
-            self.push_face(*g);
         }
         for f in first_new..self.faces.len() {
             self.gen_candidates(f);
@@ -807,4 +976,12 @@ impl Searcher {
         }
         Flow::Continue
     }
+}
+
+thread_local! {
+    /// Debug counters.
+    pub static STATS: std::cell::RefCell<[u64; 8]> = const { std::cell::RefCell::new([0; 8]) };
+}
+fn stat(i: usize) {
+    STATS.with(|s| s.borrow_mut()[i] += 1);
 }

@@ -324,3 +324,207 @@ fn search_refills_delaunay_cavities() {
     }
     println!("{calls} cavities, {total_nodes} nodes");
 }
+
+// ---------------------------------------------------------------------------------------------
+// Boundary recovery
+// ---------------------------------------------------------------------------------------------
+
+use biotet::check::check;
+use biotet::delaunay::Delaunay;
+use biotet::geom::intersect::{SegTri, seg_tri};
+use biotet::lastresort::{RecoverOptions, recover};
+use biotet::{SurfaceMesh, TetMesh};
+
+/// A tiny binary-STL reader (biotet cannot depend on biotet-io), exact duplicates welded.
+fn read_stl(name: &str) -> SurfaceMesh {
+    let path = format!("{}/../../tests/data/{name}", env!("CARGO_MANIFEST_DIR"));
+    let bytes = std::fs::read(path).expect("read STL");
+    let n = u32::from_le_bytes(bytes[80..84].try_into().unwrap()) as usize;
+    assert_eq!(bytes.len(), 84 + 50 * n, "binary STL size");
+    let f = |o: usize| f32::from_le_bytes(bytes[o..o + 4].try_into().unwrap()) as f64;
+    let mut points = Vec::with_capacity(3 * n);
+    let mut triangles = Vec::with_capacity(n);
+    for t in 0..n {
+        let base = 84 + 50 * t + 12;
+        for c in 0..3 {
+            let o = base + 12 * c;
+            points.push([f(o), f(o + 4), f(o + 8)]);
+        }
+        let i = 3 * t as u32;
+        triangles.push([i, i + 1, i + 2]);
+    }
+    let mut s = SurfaceMesh::closed(points, triangles, 1);
+    s.weld_exact();
+    s
+}
+
+/// Volume enclosed by a closed outward surface.
+fn enclosed_volume(s: &SurfaceMesh) -> f64 {
+    (0..s.triangles.len())
+        .map(|t| {
+            let c = s.corners(t);
+            volume(&[[0.0; 3], c[0], c[1], c[2]])
+        })
+        .sum()
+}
+
+fn mesh_volume(m: &TetMesh) -> f64 {
+    (0..m.tets.len()).map(|t| volume(&m.corners(t))).sum()
+}
+
+/// Point-in-surface by the parity of crossings of the ray towards +z (exact segment–triangle
+/// tests against the segment to a point above the surface); `None` when the ray touches an edge
+/// or vertex (then the caller decides otherwise). Triangles are bucketed on an xy grid.
+struct Inside {
+    s: SurfaceMesh,
+    top: f64,
+    lo: [f64; 2],
+    cell: f64,
+    n: usize,
+    grid: Vec<Vec<u32>>,
+}
+
+impl Inside {
+    fn new(s: &SurfaceMesh) -> Inside {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in &s.points {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        let n = 64;
+        let cell = (hi[0] - lo[0]).max(hi[1] - lo[1]) / n as f64 * 1.0001;
+        let mut grid = vec![Vec::new(); n * n];
+        for t in 0..s.triangles.len() {
+            let c = s.corners(t);
+            let ix = |x: f64, k: usize| (((x - lo[k]) / cell) as usize).min(n - 1);
+            let (x0, x1) = (
+                ix(c.iter().map(|p| p[0]).fold(f64::INFINITY, f64::min), 0),
+                ix(c.iter().map(|p| p[0]).fold(f64::NEG_INFINITY, f64::max), 0),
+            );
+            let (y0, y1) = (
+                ix(c.iter().map(|p| p[1]).fold(f64::INFINITY, f64::min), 1),
+                ix(c.iter().map(|p| p[1]).fold(f64::NEG_INFINITY, f64::max), 1),
+            );
+            for x in x0..=x1 {
+                for y in y0..=y1 {
+                    grid[y * n + x].push(t as u32);
+                }
+            }
+        }
+        Inside {
+            s: s.clone(),
+            top: hi[2] + 1.0,
+            lo: [lo[0], lo[1]],
+            cell,
+            n,
+            grid,
+        }
+    }
+
+    fn contains(&self, p: P3) -> Option<bool> {
+        let ix = ((p[0] - self.lo[0]) / self.cell).floor();
+        let iy = ((p[1] - self.lo[1]) / self.cell).floor();
+        if ix < 0.0 || iy < 0.0 || ix >= self.n as f64 || iy >= self.n as f64 {
+            return Some(false);
+        }
+        let q = [p[0], p[1], self.top];
+        let mut odd = false;
+        for &t in &self.grid[iy as usize * self.n + ix as usize] {
+            match seg_tri(p, q, &self.s.corners(t as usize)) {
+                SegTri::Disjoint => {}
+                SegTri::Proper => odd = !odd,
+                _ => return None,
+            }
+        }
+        Some(odd)
+    }
+}
+
+/// The Delaunay mesh of the surface's points with the tets whose centroid is outside removed.
+fn delaunay_trimmed(s: &SurfaceMesh) -> TetMesh {
+    let dt = Delaunay::new(&s.points).unwrap();
+    let mut m = dt.to_tet_mesh();
+    let inside = Inside::new(s);
+    let keep: Vec<bool> = (0..m.tets.len())
+        .map(|t| {
+            let c = m.corners(t);
+            let g = |w: [f64; 4]| [0, 1, 2].map(|k| (0..4).map(|i| w[i] * c[i][k]).sum::<f64>());
+            // The centroid, or nearby interior points when its ray grazes an edge.
+            [[0.25; 4], [0.3, 0.24, 0.23, 0.23], [0.22, 0.31, 0.26, 0.21]]
+                .iter()
+                .find_map(|&w| inside.contains(g(w)))
+                .unwrap_or(false)
+        })
+        .collect();
+    let mut k = 0;
+    for t in 0..m.tets.len() {
+        if keep[t] {
+            m.tets[k] = m.tets[t];
+            k += 1;
+        }
+    }
+    m.tets.truncate(k);
+    m.labels.truncate(k);
+    m.rebuild_neighbors();
+    m
+}
+
+fn recover_and_check(name: &str, s: &SurfaceMesh, mut m: TetMesh, opts: &RecoverOptions) {
+    let n_points = m.points.len();
+    let t = std::time::Instant::now();
+    let r = recover(&mut m, s, opts).unwrap();
+    let dt = t.elapsed();
+    println!(
+        "{name}: {:?}, tets {} -> {}, missing {} -> {}, calls {} ({} ok, {} grown), \
+         ms/call median {:.3} max {:.3}, nodes/call median {} max {}, cavity tets median {}, \
+         {:.1} ms total ({dt:.2?})",
+        r.domain,
+        r.tets_before,
+        r.tets_after,
+        r.missing_before,
+        r.missing_after,
+        r.calls,
+        r.calls_succeeded,
+        r.cavities_grown,
+        r.call_ms_median,
+        r.call_ms_max,
+        r.nodes_median,
+        r.nodes_max,
+        r.cavity_tets_median,
+        r.total_ms
+    );
+    for u in r.unrecovered.iter().take(5) {
+        println!("  unrecovered {u:?}");
+    }
+    assert!(r.missing_before > 0);
+    assert!(r.is_complete(), "{} triangles unrecovered", r.missing_after);
+    assert_eq!(m.points.len(), n_points, "no new points");
+    let c = check(&m, Some(s));
+    assert!(c.valid, "{c}");
+    let (v, v0) = (mesh_volume(&m), enclosed_volume(s));
+    assert!((v - v0).abs() < 1e-9 * v0, "volume {v} vs {v0}");
+}
+
+#[test]
+fn recover_brain_delaunay_trimmed() {
+    let s = read_stl("brain_20k.stl");
+    let m = delaunay_trimmed(&s);
+    recover_and_check("brain_20k trimmed", &s, m, &RecoverOptions::default());
+}
+
+#[test]
+fn recover_brain_delaunay_hull() {
+    let s = read_stl("brain_20k.stl");
+    let m = Delaunay::new(&s.points).unwrap().to_tet_mesh();
+    recover_and_check("brain_20k hull", &s, m, &RecoverOptions::default());
+}
+
+#[test]
+fn recover_white_matter_delaunay_trimmed() {
+    let s = read_stl("wm_20k.stl");
+    let m = delaunay_trimmed(&s);
+    recover_and_check("wm_20k trimmed", &s, m, &RecoverOptions::default());
+}
