@@ -34,7 +34,8 @@
 //! report lists each unrecovered triangle with its corners, smallest angle and the reason; the
 //! seed's experience is that the root cause is a flawed or very poor input triangle. With
 //! [`RecoverOptions::allow_interior_steiner`], a failed cavity is searched again with one new
-//! point strictly inside it (the centroid of a carved tet, never on the surface).
+//! point strictly inside it (the average of the cavity's points, when it is strictly inside a
+//! carved tet and on no surface triangle), on each ring of growth.
 //!
 //! # Limits
 //! The surface must be valid (closed, oriented, not self-intersecting: [`crate::mesh::validate`]);
@@ -78,7 +79,7 @@ impl Default for RecoverOptions {
         RecoverOptions {
             search: SearchOptions {
                 min_quality: 0.0,
-                max_nodes: 5_000,
+                max_nodes: 2_000,
                 improve: None,
             },
             max_grow: 6,
@@ -221,9 +222,6 @@ pub fn recover(
         r.run_steiner();
     }
     r.compact();
-    if std::env::var_os("BIOTET_LR_DEBUG").is_some() {
-        super::search::STATS.with(|s| eprintln!("stats {:?}", s.borrow()));
-    }
     let (removed, conflicts) = r.relabel();
 
     let mut unrecovered = Vec::new();
@@ -377,10 +375,23 @@ struct Cavity {
     half: Vec<[u32; 3]>,
 }
 
+/// Where a surface triangle lies relative to a cavity.
+enum Place {
+    Inside,
+    Outside,
+    /// In the plane of the listed mesh boundary faces of the cavity (indices into the shell),
+    /// overlapping them; `inward`: its own orientation faces into the cavity.
+    OnBoundary {
+        faces: Vec<usize>,
+        inward: bool,
+    },
+}
+
 enum Failure {
     /// The missing triangle is not inside the cavity (crosses its shell).
     NotInside,
     TooLarge,
+    NoSteiner,
     Cells,
     Search(SearchError),
 }
@@ -390,6 +401,7 @@ impl Failure {
         match self {
             Failure::NotInside => "the triangle leaves the largest cavity tried".into(),
             Failure::TooLarge => "the cavity grew too large".into(),
+            Failure::NoSteiner => "no interior point could be placed in the cavity".into(),
             Failure::Cells => "the cavity's constrained faces do not split it into cells".into(),
             Failure::Search(SearchError::NoFill { .. }) => {
                 "no fill of the cavity exists without new points (search exhausted)".into()
@@ -610,21 +622,6 @@ impl<'a> Recovery<'a> {
                 Err(f)
             }
         };
-        if std::env::var_os("BIOTET_LR_DEBUG").is_some() {
-            eprintln!(
-                "call: {} tets, {} points, {} half-faces, {} nodes, {:.3} ms, {}",
-                cav.tets.len(),
-                cav.points.len(),
-                cav.half.len(),
-                nodes,
-                start.elapsed().as_secs_f64() * 1e3,
-                match &ok {
-                    Ok(()) => "ok".to_string(),
-                    Err(f) => f.describe(),
-                }
-            );
-            super::search::STATS.with(|s| eprintln!("stats {:?}", s.borrow()));
-        }
         self.call_ms.push(start.elapsed().as_secs_f64() * 1e3);
         self.call_nodes.push(nodes);
         self.call_sizes.push(cav.tets.len());
@@ -676,6 +673,7 @@ impl<'a> Recovery<'a> {
             }
         }
         // Constrained faces.
+        let mut dropped = vec![false; cav.shell.len()];
         let mut seen: FxHashSet<u32> = FxHashSet::default();
         let mut found_m = false;
         let mkey = sorted3(m);
@@ -694,20 +692,46 @@ impl<'a> Recovery<'a> {
                 if shell_keys.contains(&key) {
                     continue;
                 }
-                let inside = self.interior_face(v, st) || self.inside_cavity(v, cav, st);
-                if !inside {
-                    if key == mkey {
-                        return Err(Failure::NotInside);
+                let place = if self.interior_face(v, st) {
+                    Place::Inside
+                } else {
+                    self.inside_cavity(v, cav, st)
+                };
+                let l = v.map(|y| self.pt_local[y as usize]);
+                match place {
+                    Place::Outside => {
+                        if key == mkey {
+                            return Err(Failure::NotInside);
+                        }
+                        continue;
                     }
-                    continue;
+                    Place::Inside => {
+                        cav.half.push(l);
+                        cav.half.push([l[0], l[2], l[1]]);
+                    }
+                    Place::OnBoundary { faces, inward } => {
+                        for k in faces {
+                            dropped[k] = true;
+                        }
+                        cav.half.push(if inward { l } else { [l[0], l[2], l[1]] });
+                    }
                 }
                 if key == mkey {
                     found_m = true;
                 }
-                let l = v.map(|y| self.pt_local[y as usize]);
-                cav.half.push(l);
-                cav.half.push([l[0], l[2], l[1]]);
             }
+        }
+        if dropped.iter().any(|&d| d) {
+            // Boundary faces re-triangulated by surface triangles in their plane.
+            let n_shell = dropped.len();
+            let mut k = 0;
+            for i in 0..cav.half.len() {
+                if i >= n_shell || !dropped[i] {
+                    cav.half[k] = cav.half[i];
+                    k += 1;
+                }
+            }
+            cav.half.truncate(k);
         }
         if !found_m {
             return Err(Failure::NotInside);
@@ -738,7 +762,10 @@ impl<'a> Recovery<'a> {
     /// then the point `x = u + ε(w − u) + δ(v − u)` (0 < δ ≪ ε infinitesimal, inside the
     /// triangle next to corner `u`) is located in the carved tets at `u`. The orientation of `x`
     /// against a plane is the first non-zero of its orientations of `u`, `w`, `v`.
-    fn inside_cavity(&self, v: [u32; 3], cav: &Cavity, st: u32) -> bool {
+    ///
+    /// A triangle in the plane of mesh boundary faces of the cavity (a surface triangle on the
+    /// convex hull, split differently) is [`Place::OnBoundary`]: those faces are replaced by it.
+    fn inside_cavity(&self, v: [u32; 3], cav: &Cavity, st: u32) -> Place {
         let tp = v.map(|x| self.mesh.points[x as usize]);
         let (mut lo, mut hi) = (tp[0], tp[0]);
         for p in &tp[1..] {
@@ -747,14 +774,40 @@ impl<'a> Recovery<'a> {
                 hi[k] = hi[k].max(p[k]);
             }
         }
-        for (g, _, _) in &cav.shell {
+        let mut on_boundary = Vec::new();
+        for (i, (g, n, _)) in cav.shell.iter().enumerate() {
             let gp = g.map(|x| self.mesh.points[x as usize]);
             if (0..3).any(|k| gp.iter().all(|p| p[k] < lo[k]) || gp.iter().all(|p| p[k] > hi[k])) {
                 continue;
             }
             if tri_tri(&tp, &gp) == TriTri::Improper {
-                return false;
+                let coplanar = tp
+                    .iter()
+                    .all(|&p| orient3d(gp[0], gp[1], gp[2], p) == Sign::Zero);
+                if *n == NO_NEIGHBOR && coplanar {
+                    on_boundary.push(i);
+                    continue;
+                }
+                return Place::Outside;
             }
+        }
+        if let Some(&i) = on_boundary.first() {
+            // Orient it like the boundary faces seen from inside: towards the cavity tet's apex.
+            let g = cav.shell[i].0;
+            let apex = cav.tets.iter().find_map(|&t| {
+                let tv = self.mesh.tets[t as usize];
+                let inside = g.iter().all(|x| tv.contains(x));
+                inside.then(|| tv.into_iter().find(|x| !g.contains(x)))?
+            });
+            let Some(apex) = apex else {
+                return Place::Outside;
+            };
+            let inward =
+                orient3d(tp[0], tp[1], tp[2], self.mesh.points[apex as usize]) == Sign::Positive;
+            return Place::OnBoundary {
+                faces: on_boundary,
+                inward,
+            };
         }
         let [u, vv, w] = tp;
         for &t in &self.vert_tets[v[0] as usize] {
@@ -774,10 +827,10 @@ impl<'a> Recovery<'a> {
                 s != Sign::Positive
             });
             if inside {
-                return true;
+                return Place::Inside;
             }
         }
-        false
+        Place::Outside
     }
 
     /// Split into cells and search each; the new tets in global numbering.
@@ -905,31 +958,27 @@ impl<'a> Recovery<'a> {
         }
     }
 
-    /// Put one point strictly inside the cavity: the centroid of its largest carved tet, when
-    /// strictly inside that tet and not on the surface.
+    /// Put one point strictly inside the cavity: the average of the cavity's points, when it
+    /// lies strictly inside a carved tet and on no surface triangle (exact tests).
     fn add_steiner(&mut self, cav: &mut Cavity) -> Result<(), Failure> {
-        let mut best = None;
-        let mut best_v = 0.0;
-        for &t in &cav.tets {
-            let c = self.mesh.corners(t as usize);
-            let v = crate::quality::tet::volume(&c);
-            if v > best_v {
-                best_v = v;
-                best = Some(c);
+        let n = cav.coords.len().max(1) as f64;
+        let mut p = [0.0; 3];
+        for c in &cav.coords {
+            for k in 0..3 {
+                p[k] += c[k] / n;
             }
         }
-        let Some(c) = best else {
-            return Err(Failure::TooLarge);
-        };
-        let p = [0, 1, 2].map(|k| (c[0][k] + c[1][k] + c[2][k] + c[3][k]) / 4.0);
-        let strictly = TET_FACES
-            .iter()
-            .all(|f| orient3d(c[f[0]], c[f[1]], c[f[2]], p) == Sign::Negative);
+        let strictly = cav.tets.iter().any(|&t| {
+            let c = self.mesh.corners(t as usize);
+            TET_FACES
+                .iter()
+                .all(|f| orient3d(c[f[0]], c[f[1]], c[f[2]], p) == Sign::Negative)
+        });
         if !strictly || !p.iter().all(|&x| in_exact_range(x)) || self.on_surface(p) {
-            return Err(Failure::TooLarge);
+            return Err(Failure::NoSteiner);
         }
         let id = self.mesh.points.len() as u32;
-        // Provisionally a cavity point; committed by `insert` only if the fill succeeds.
+        // A cavity point now; removed again by `carve_and_fill` if the fill fails.
         self.mesh.points.push(p);
         self.vert_tets.push(Vec::new());
         self.surf_at.push(Vec::new());

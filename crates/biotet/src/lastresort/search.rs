@@ -39,7 +39,7 @@
 //! ([`SearchError::NoFill`]).
 
 use crate::geom::filter::orient3d;
-use crate::geom::intersect::{TriTri, is_degenerate, tri_tri};
+use crate::geom::intersect::{TriTri, is_degenerate, seg_tri, tri_tri};
 use crate::geom::predicates::{Sign, in_exact_range};
 use crate::quality::tet::q_measure;
 use rustc_hash::FxHashMap;
@@ -540,17 +540,34 @@ impl Searcher {
         })
     }
 
-    /// Do the triangles `f` and `g` (distinct vertex sets) meet other than in shared corners or
-    /// a shared edge? Exact; the plane tests settle the common cases without [`tri_tri`].
-    fn tri_conflict(&self, f: [u32; 3], g: [u32; 3]) -> bool {
-        let one_side = |a: [u32; 3], b: [u32; 3]| {
+    /// Do the triangles `f` (plane `fpl`) and `g` (plane `gpl`), distinct vertex sets, meet
+    /// other than in shared corners or a shared edge? Exact. Plane tests (cached orientations)
+    /// settle the common cases; triangles without a shared corner are decided by their edges
+    /// (for triangles in different planes, they meet iff an edge of one meets the other);
+    /// coplanar pairs and pairs with one shared corner go to [`tri_tri`].
+    fn tri_conflict(&self, f: [u32; 3], fpl: Plane, g: [u32; 3], gpl: Plane) -> bool {
+        let sg = g.map(|x| {
+            if f.contains(&x) {
+                Sign::Zero
+            } else {
+                self.outer(fpl, x)
+            }
+        });
+        let sf = f.map(|x| {
+            if g.contains(&x) {
+                Sign::Zero
+            } else {
+                self.outer(gpl, x)
+            }
+        });
+        let one_side = |s: &[Sign; 3], v: [u32; 3], other: [u32; 3]| {
             let mut pos = false;
             let mut neg = false;
-            for &x in &b {
-                if a.contains(&x) {
+            for k in 0..3 {
+                if other.contains(&v[k]) {
                     continue;
                 }
-                match self.o(a[0], a[1], a[2], x) {
+                match s[k] {
                     Sign::Positive => pos = true,
                     Sign::Negative => neg = true,
                     Sign::Zero => return false,
@@ -558,13 +575,49 @@ impl Searcher {
             }
             !(pos && neg)
         };
-        if one_side(f, g) || one_side(g, f) {
+        if one_side(&sg, g, f) || one_side(&sf, f, g) {
             return false;
+        }
+        let shared = g.iter().filter(|x| f.contains(x)).count();
+        let coplanar = sg.iter().all(|&x| x == Sign::Zero);
+        if shared == 0 && !coplanar {
+            return (0..3).any(|k| self.seg_meets(f[k], f[(k + 1) % 3], sf[k], sf[(k + 1) % 3], g))
+                || (0..3).any(|k| self.seg_meets(g[k], g[(k + 1) % 3], sg[k], sg[(k + 1) % 3], f));
         }
         let fp = f.map(|x| self.pts[x as usize]);
         let gp = g.map(|x| self.pts[x as usize]);
-        stat(0);
         tri_tri(&fp, &gp) == TriTri::Improper
+    }
+
+    /// Does segment `xy` meet the closed triangle `t` (no corner shared)? `sx`, `sy`: the
+    /// orientations of `x`, `y` against `t`'s plane (in any one sign convention).
+    fn seg_meets(&self, x: u32, y: u32, sx: Sign, sy: Sign, t: [u32; 3]) -> bool {
+        if sx != Sign::Zero && sx == sy {
+            return false;
+        }
+        let p = &self.pts;
+        let tp = t.map(|i| p[i as usize]);
+        if sx == Sign::Zero && sy == Sign::Zero {
+            return seg_tri(p[x as usize], p[y as usize], &tp).meets();
+        }
+        // The line crosses the plane at one point; its barycentric signs are the orientations
+        // of the line against the triangle's edges, times the sign of its direction · normal.
+        let ox = self.o(t[0], t[1], t[2], x);
+        let oy = self.o(t[0], t[1], t[2], y);
+        let dn_positive = oy == Sign::Positive || ox == Sign::Negative;
+        let lam = [
+            self.o4(x, y, t[1], t[2]).times(dn_positive),
+            self.o4(x, y, t[2], t[0]).times(dn_positive),
+            self.o4(x, y, t[0], t[1]).times(dn_positive),
+        ];
+        !lam.contains(&Sign::Negative)
+    }
+
+    /// Plain exact orientation of four distinct points.
+    #[inline]
+    fn o4(&self, a: u32, b: u32, c: u32, d: u32) -> Sign {
+        let p = &self.pts;
+        orient3d(p[a as usize], p[b as usize], p[c as usize], p[d as usize])
     }
 
     /// The outward planes of the candidate tet `face + p`.
@@ -615,15 +668,11 @@ impl Searcher {
             let (lo, hi) = bbox4(&corners);
             let (tf, planes) = self.cand_planes(f as u32, p);
             let t = [v[0], v[1], v[2], p];
-            stat(1);
-            if self.contains_point(t, &planes, lo, hi) {
+            if self.contains_point(t, &planes, lo, hi)
+                || self.hits_front(t, &tf, &planes, f as u32, lo, hi)
+            {
                 continue;
             }
-            stat(2);
-            if self.hits_front(t, &tf, &planes, f as u32, lo, hi) {
-                continue;
-            }
-            stat(3);
             self.cands.push(Cand {
                 p,
                 q,
@@ -712,7 +761,7 @@ impl Searcher {
         lo: P3,
         hi: P3,
     ) -> bool {
-        for (g, face) in self.faces.iter().enumerate() {
+        for (g, face) in self.faces.iter().enumerate().rev() {
             if !face.alive || g as u32 == base {
                 continue;
             }
@@ -751,7 +800,6 @@ impl Searcher {
         if tf.iter().any(|f| same_set(*f, g)) {
             return false;
         }
-        stat(4);
         // g's plane (cached) with the tet on one closed side, touching only at corners of g.
         let mut pos = false;
         let mut neg = false;
@@ -766,15 +814,13 @@ impl Searcher {
         if !cut && !(pos && neg) {
             return false;
         }
-        stat(5);
         // A face plane of the tet with g on its closed outer side.
         for k in (0..4).rev() {
             if self.separates(planes[k], tf[k], &g) {
                 return false;
             }
         }
-        stat(6);
-        tf[..3].iter().any(|f| self.tri_conflict(*f, g))
+        (0..3).any(|k| self.tri_conflict(tf[k], planes[k], g, Plane::Face(gid, false)))
     }
 
     /// Do the candidate tet `c` (outward faces `cf`, planes `cp`) and the new tet (faces `tf`,
@@ -797,9 +843,9 @@ impl Searcher {
         {
             return false;
         }
-        for f in cf {
-            for g in tf {
-                if !same_set(*f, *g) && self.tri_conflict(*f, *g) {
+        for (i, f) in cf.iter().enumerate() {
+            for (k, g) in tf.iter().enumerate() {
+                if !same_set(*f, *g) && self.tri_conflict(*f, cp[i], *g, tp[k]) {
                     return true;
                 }
             }
@@ -978,10 +1024,51 @@ impl Searcher {
     }
 }
 
-thread_local! {
-    /// Debug counters.
-    pub static STATS: std::cell::RefCell<[u64; 8]> = const { std::cell::RefCell::new([0; 8]) };
-}
-fn stat(i: usize) {
-    STATS.with(|s| s.borrow_mut()[i] += 1);
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The plane-and-edge triangle test agrees with the exact [`tri_tri`] on lattice triangles,
+    /// shared corners included.
+    #[test]
+    fn tri_conflict_matches_tri_tri() {
+        // All points of a small lattice, indexed.
+        let mut pts = Vec::new();
+        for x in -1..=1 {
+            for y in -1..=1 {
+                for z in -1..=1 {
+                    pts.push([x as f64, y as f64, z as f64 * 0.5 + (x * y) as f64 * 0.25]);
+                }
+            }
+        }
+        let mut s = Searcher::new();
+        s.pts = pts.clone();
+        s.raw = vec![Cell::new((0, 0)); 3 * pts.len()];
+        s.raw_stamp.set(1);
+        let n = pts.len() as u64;
+        let mut seed = 12345u64;
+        let mut next = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 33) % n) as u32
+        };
+        let mut checked = 0;
+        while checked < 20000 {
+            let f = [next(), next(), next()];
+            let g = [next(), next(), next()];
+            let fp = f.map(|i| pts[i as usize]);
+            let gp = g.map(|i| pts[i as usize]);
+            if f[0] == f[1] || f[1] == f[2] || f[0] == f[2] || g[0] == g[1] || g[1] == g[2] {
+                continue;
+            }
+            if g[0] == g[2] || is_degenerate(&fp) || is_degenerate(&gp) || same_set(f, g) {
+                continue;
+            }
+            s.raw_stamp.set(s.raw_stamp.get() + 1);
+            let got = s.tri_conflict(f, Plane::Tri(0, f), g, Plane::Tri(1, g));
+            assert_eq!(got, tri_tri(&fp, &gp) == TriTri::Improper, "{f:?} {g:?}");
+            checked += 1;
+        }
+    }
 }

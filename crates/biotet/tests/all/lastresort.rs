@@ -528,3 +528,129 @@ fn recover_white_matter_delaunay_trimmed() {
     let m = delaunay_trimmed(&s);
     recover_and_check("wm_20k trimmed", &s, m, &RecoverOptions::default());
 }
+
+/// A closed outward surface from inward shell faces (reversed), one region.
+fn surface_of(points: &[P3], inward: &[[u32; 3]]) -> SurfaceMesh {
+    SurfaceMesh::closed(
+        points.to_vec(),
+        inward.iter().map(|f| [f[0], f[2], f[1]]).collect(),
+        1,
+    )
+}
+
+/// Recover `s` in the Delaunay mesh of its points (and `extra` points): valid, every triangle.
+fn recover_small(s: &SurfaceMesh, extra: &[P3]) -> biotet::lastresort::RecoverReport {
+    let mut pts = s.points.clone();
+    pts.extend_from_slice(extra);
+    let mut m = Delaunay::new(&pts).unwrap().to_tet_mesh();
+    let r = recover(&mut m, s, &RecoverOptions::default()).unwrap();
+    assert!(r.is_complete(), "{r:?}");
+    let c = check(&m, Some(s));
+    assert!(c.valid, "{c}");
+    let (v, v0) = (mesh_volume(&m), enclosed_volume(s));
+    assert!((v - v0).abs() < 1e-12 * v0.max(1.0), "{v} vs {v0}");
+    r
+}
+
+#[test]
+fn recover_unit_shells() {
+    let (p, f) = cube();
+    let r = recover_small(&surface_of(&p, &f), &[]);
+    println!("cube: missing {}", r.missing_before);
+    // Diagonals the other way than the Delaunay split picks: some must be recovered.
+    let (p, f) = cube();
+    let flipped: Vec<[u32; 3]> = f
+        .chunks(2)
+        .flat_map(|q| {
+            let (a, b) = (q[0], q[1]); // a = [q0 q1 q2], b = [q0 q2 q3]
+            [[a[0], a[1], b[2]], [a[1], a[2], b[2]]]
+        })
+        .collect();
+    let s = surface_of(&p, &flipped);
+    let r = recover_small(&s, &[[0.5, 0.5, 0.5]]);
+    println!("cube, other diagonals: missing {}", r.missing_before);
+    let (p, f) = twisted_prism(30.0, true);
+    recover_small(&surface_of(&p, &f), &[]);
+    // The octahedron with points inside.
+    let pts: Vec<P3> = vec![
+        [1.0, 0.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+    ];
+    let out = [
+        [0, 2, 4],
+        [2, 1, 4],
+        [1, 3, 4],
+        [3, 0, 4],
+        [2, 0, 5],
+        [1, 2, 5],
+        [3, 1, 5],
+        [0, 3, 5],
+    ];
+    let s = SurfaceMesh::closed(pts, out.to_vec(), 1);
+    recover_small(&s, &[[0.1, 0.2, 0.05], [-0.2, 0.1, -0.3]]);
+}
+
+#[test]
+fn recover_fails_honestly_on_schoenhardt() {
+    let (p, f) = twisted_prism(30.0, false);
+    let s = surface_of(&p, &f);
+    let mut m = Delaunay::new(&p).unwrap().to_tet_mesh();
+    let r = recover(&mut m, &s, &RecoverOptions::default()).unwrap();
+    assert!(!r.is_complete());
+    assert_eq!(r.missing_after, r.unrecovered.len());
+    assert!(r.missing_before >= 3);
+    for u in &r.unrecovered {
+        assert!(u.reason.contains("no fill"), "{}", u.reason);
+        assert!(u.min_angle_deg > 0.0);
+        assert_eq!(u.corners, s.corners(u.triangle));
+    }
+    assert_eq!(r.points_added, 0);
+    assert_eq!(m.points.len(), 6);
+    // With one interior point allowed, it is recovered.
+    let mut m = Delaunay::new(&p).unwrap().to_tet_mesh();
+    let opts = RecoverOptions {
+        allow_interior_steiner: true,
+        ..RecoverOptions::default()
+    };
+    let r = recover(&mut m, &s, &opts).unwrap();
+    assert!(r.is_complete(), "{r:?}");
+    assert_eq!(r.points_added, 1);
+    assert_eq!(m.points.len(), 7);
+    let c = check(&m, Some(&s));
+    assert!(c.valid, "{c}");
+}
+
+#[test]
+fn recover_nested_interface_labels() {
+    // Two nested cubes: region 2 inside, region 1 between; the inner surface is an interface.
+    let (p, f) = cube();
+    let mut pts: Vec<P3> = p.iter().map(|x| x.map(|c| c * 3.0)).collect();
+    pts.extend(p.iter().map(|x| x.map(|c| c + 1.0)));
+    let mut tris: Vec<[u32; 3]> = f.iter().map(|t| [t[0], t[2], t[1]]).collect();
+    let mut sides = vec![[1, 0]; tris.len()];
+    tris.extend(f.iter().map(|t| [t[0] + 8, t[2] + 8, t[1] + 8]));
+    sides.extend(std::iter::repeat_n([2, 1], f.len()));
+    let s = SurfaceMesh {
+        points: pts.clone(),
+        triangles: tris,
+        sides,
+    };
+    let mut m = Delaunay::new(&pts).unwrap().to_tet_mesh();
+    let r = recover(&mut m, &s, &RecoverOptions::default()).unwrap();
+    assert!(r.is_complete(), "{r:?}");
+    let c = check(&m, Some(&s));
+    assert!(c.valid, "{c}");
+    assert_eq!(m.regions(), vec![1, 2]);
+    let vol = |l: u32| -> f64 {
+        (0..m.tets.len())
+            .filter(|&t| m.labels[t] == l)
+            .map(|t| volume(&m.corners(t)))
+            .sum()
+    };
+    assert!((vol(2) - 1.0).abs() < 1e-12, "{}", vol(2));
+    assert!((vol(1) - 26.0).abs() < 1e-12, "{}", vol(1));
+}
