@@ -107,7 +107,6 @@ impl Cells {
             i = j;
         }
         cell.clear();
-        cell.resize(faces.len(), u32::MAX);
         let mut root_cell: Vec<u32> = vec![u32::MAX; faces.len()];
         let mut n = 0;
         for f in 0..faces.len() {
@@ -116,7 +115,7 @@ impl Cells {
                 root_cell[r] = n;
                 n += 1;
             }
-            cell[f] = root_cell[r];
+            cell.push(root_cell[r]);
         }
         Ok(n as usize)
     }

@@ -17,13 +17,16 @@
 //!    constrained face (`M` itself and any other missing triangles "the hole offers", and the
 //!    present ones already inside): inside means no improper contact with a shell face (exact
 //!    [`tri_tri`]) and a point of its interior inside a cavity tet (exact, by a symbolic point
-//!    infinitesimally close to a corner, see [`Recovery::inside_cavity`]). The shell and both
-//!    sides of each constrained face split the cavity into closed cells
-//!    ([`super::cells`]), and [`Searcher`] fills each cell with cavity points only (points left
-//!    isolated by the carving are offered to every cell).
-//! 4. A cavity that fails is **grown** (the tets around every vertex of the cavity: the next
-//!    ring) and tried again, up to [`RecoverOptions::max_grow`] times; a triangle whose cavity
-//!    still fails moves to the back of the queue. The queue stops when a whole round fails.
+//!    infinitesimally close to a corner, see `Recovery::inside_cavity`). A surface triangle in
+//!    the plane of mesh boundary faces of the cavity (on the convex hull, split differently)
+//!    replaces them, one-sided. The shell and both sides of each constrained face split the
+//!    cavity into closed cells (exact angular order of the faces around each edge), and
+//!    [`Searcher`] fills each cell with cavity points only (points left isolated by the carving
+//!    are offered to every cell).
+//! 4. A cavity that fails is **grown** by the next ring (every tet across one of its faces) and
+//!    tried again, up to [`RecoverOptions::max_grow`] times or [`RecoverOptions::max_cavity_tets`]
+//!    tets; a triangle whose cavity still fails moves to the back of the queue. The queue stops
+//!    when every remaining triangle failed since the last success.
 //! 5. **Labels** by flood fill: tets connected without crossing a surface triangle form a
 //!    region; the side labels of the surface triangles around it name it (`sides = [back,
 //!    front]`), so interfaces get the right label on each side. Tets of region 0 (the outside)
@@ -40,7 +43,9 @@
 //! # Limits
 //! The surface must be valid (closed, oriented, not self-intersecting: [`crate::mesh::validate`]);
 //! a mesh that does not cover the surface's domain and is not a sub-complex of the Delaunay
-//! tetrahedralization of its points is refused.
+//! tetrahedralization of its points is refused. Cost: a cavity of the brain_20k Delaunay mesh
+//! (about 60 tets) takes about 60 search nodes and 1–3 ms in release; a cavity whose search
+//! exhausts its node budget costs up to a few hundred ms.
 
 use super::cells::Cells;
 use super::search::{SearchError, SearchOptions, Searcher};
@@ -723,15 +728,11 @@ impl<'a> Recovery<'a> {
         }
         if dropped.iter().any(|&d| d) {
             // Boundary faces re-triangulated by surface triangles in their plane.
-            let n_shell = dropped.len();
-            let mut k = 0;
-            for i in 0..cav.half.len() {
-                if i >= n_shell || !dropped[i] {
-                    cav.half[k] = cav.half[i];
-                    k += 1;
-                }
-            }
-            cav.half.truncate(k);
+            let mut i = 0;
+            cav.half.retain(|_| {
+                i += 1;
+                dropped.get(i - 1).is_none_or(|&d| !d)
+            });
         }
         if !found_m {
             return Err(Failure::NotInside);

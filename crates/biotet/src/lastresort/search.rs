@@ -662,7 +662,9 @@ impl Searcher {
             let d = self.pts[p as usize];
             let corners = [a, b, c, d];
             let q = q_measure(&corners);
-            if (self.eta > 0.0 && !(q > self.eta)) || q <= self.bound {
+            if (self.eta > 0.0 && q.partial_cmp(&self.eta) != Some(std::cmp::Ordering::Greater))
+                || q <= self.bound
+            {
                 continue;
             }
             let (lo, hi) = bbox4(&corners);
@@ -811,7 +813,7 @@ impl Searcher {
                 Sign::Zero => cut |= !g.contains(&x),
             }
         }
-        if !cut && !(pos && neg) {
+        if !cut && (!pos || !neg) {
             return false;
         }
         // A face plane of the tet with g on its closed outer side.

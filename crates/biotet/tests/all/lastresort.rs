@@ -460,8 +460,8 @@ fn delaunay_trimmed(s: &SurfaceMesh) -> TetMesh {
         })
         .collect();
     let mut k = 0;
-    for t in 0..m.tets.len() {
-        if keep[t] {
+    for (t, &kept) in keep.iter().enumerate() {
+        if kept {
             m.tets[k] = m.tets[t];
             k += 1;
         }
