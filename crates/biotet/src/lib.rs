@@ -11,6 +11,7 @@
 pub mod check;
 pub mod delaunay;
 pub mod geom;
+pub mod lastresort;
 pub mod mesh;
 pub mod pipeline;
 pub mod quality;

@@ -4,6 +4,7 @@ mod check;
 mod common;
 mod delaunay;
 mod forced;
+mod lastresort;
 mod predicates;
 mod quality;
 mod shells;

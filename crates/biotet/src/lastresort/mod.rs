@@ -1,0 +1,18 @@
+//! LAST RESORT (dissertation chapter 3): fill cavities by exhaustive search, and recover missing
+//! surface triangles of a tet mesh by carving and refilling cavities, without new points on the
+//! surface.
+//!
+//! - [`search`]: Algorithm 3.1, the search that fills a closed cavity shell with tets whose
+//!   corners are cavity points ([`fill`], [`Searcher`]).
+//! - [`recover`](mod@recover): Algorithm 3.2, the boundary recovery driver ([`recover()`]).
+//!
+//! Every combinatorial decision is an exact predicate (orient3d, exact segment–triangle and
+//! triangle–triangle tests); floating point only ranks tets by quality.
+
+mod cells;
+pub mod recover;
+pub mod search;
+
+pub use recover::{Domain, RecoverError, RecoverOptions, RecoverReport, Unrecovered, recover};
+
+pub use search::{Fill, SearchError, SearchOptions, Searcher, fill};

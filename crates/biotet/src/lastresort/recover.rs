@@ -1,0 +1,1190 @@
+//! Boundary recovery (Algorithm 3.2 of the seed, section 3.3.2): make every triangle of a
+//! surface a face of a tet mesh by carving cavities and refilling them with the LAST RESORT
+//! search, without new points on the surface.
+//!
+//! # Algorithm
+//! 1. **Domain.** The cavities are refilled inside the mesh, so the mesh must cover the space
+//!    the surface needs. A mesh whose boundary is convex (a Delaunay mesh of the convex hull) is
+//!    used as it is. A mesh with outside tets removed (centroid test) is first completed: if its
+//!    tets are tets of the Delaunay tetrahedralization of its points (as when it was made by a
+//!    Delaunay mesher), the missing Delaunay tets are put back as outside (label 0). Otherwise
+//!    recovery fails with [`RecoverError::NotCovering`].
+//! 2. **Missing triangles**: surface triangles (corners matched to mesh points by exact
+//!    coordinates) that are no face of any tet.
+//! 3. For each missing triangle `M` (a queue): the **cavity** is every tet with a corner of `M`.
+//!    Its shell (faces shared with kept tets and mesh boundary faces) is kept exactly. Every
+//!    surface triangle with its three corners in the cavity that lies inside it becomes a
+//!    constrained face (`M` itself and any other missing triangles "the hole offers", and the
+//!    present ones already inside): inside means no improper contact with a shell face (exact
+//!    [`tri_tri`]) and a point of its interior inside a cavity tet (exact, by a symbolic point
+//!    infinitesimally close to a corner, see `Recovery::inside_cavity`). A surface triangle in
+//!    the plane of mesh boundary faces of the cavity (on the convex hull, split differently)
+//!    replaces them, one-sided. The shell and both sides of each constrained face split the
+//!    cavity into closed cells (exact angular order of the faces around each edge), and
+//!    [`Searcher`] fills each cell with cavity points only (points left isolated by the carving
+//!    are offered to every cell).
+//! 4. A cavity that fails is **grown** by the next ring (every tet across one of its faces) and
+//!    tried again, up to [`RecoverOptions::max_grow`] times or [`RecoverOptions::max_cavity_tets`]
+//!    tets; a triangle whose cavity still fails moves to the back of the queue. The queue stops
+//!    when every remaining triangle failed since the last success.
+//! 5. **Labels** by flood fill: tets connected without crossing a surface triangle form a
+//!    region; the side labels of the surface triangles around it name it (`sides = [back,
+//!    front]`), so interfaces get the right label on each side. Tets of region 0 (the outside)
+//!    are removed.
+//!
+//! # Honest failure
+//! Some shells have no tetrahedralization without new points (the Schönhardt polyhedron). The
+//! report lists each unrecovered triangle with its corners, smallest angle and the reason; the
+//! seed's experience is that the root cause is a flawed or very poor input triangle. With
+//! [`RecoverOptions::allow_interior_steiner`], a failed cavity is searched again with one new
+//! point strictly inside it (the average of the cavity's points, when it is strictly inside a
+//! carved tet and on no surface triangle), on each ring of growth.
+//!
+//! # Limits
+//! The surface must be valid (closed, oriented, not self-intersecting: [`crate::mesh::validate`]);
+//! a mesh that does not cover the surface's domain and is not a sub-complex of the Delaunay
+//! tetrahedralization of its points is refused. Cost: a cavity of the brain_20k Delaunay mesh
+//! (about 60 tets) takes about 60 search nodes and 1–3 ms in release; a cavity whose search
+//! exhausts its node budget costs up to a few hundred ms.
+
+use super::cells::Cells;
+use super::search::{SearchError, SearchOptions, Searcher};
+use crate::delaunay::Delaunay;
+use crate::geom::intersect::{TriTri, tri_tri};
+use crate::geom::predicates::{Sign, in_exact_range, orient3d};
+use crate::geom::vec3::{cross, dot, norm, sub};
+use crate::mesh::surface::SurfaceMesh;
+use crate::mesh::tet::{NO_NEIGHBOR, TET_FACES, TetMesh, sorted3};
+use rustc_hash::{FxHashMap, FxHashSet};
+use serde::Serialize;
+use std::collections::VecDeque;
+use std::time::Instant;
+use thiserror::Error;
+
+type P3 = [f64; 3];
+
+/// Options of [`recover`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RecoverOptions {
+    /// Options of each cell's search (quality threshold ηe, node budget).
+    pub search: SearchOptions,
+    /// How many times a failing cavity is grown by one ring of tets before the triangle is put
+    /// back in the queue.
+    pub max_grow: u32,
+    /// Cavities larger than this many tets are not searched.
+    pub max_cavity_tets: usize,
+    /// As a last resort, add one point strictly inside a failed cavity and search again.
+    pub allow_interior_steiner: bool,
+    /// Remove the tets of region 0 (outside the surface) at the end.
+    pub remove_outside: bool,
+}
+
+impl Default for RecoverOptions {
+    fn default() -> Self {
+        RecoverOptions {
+            search: SearchOptions {
+                min_quality: 0.0,
+                max_nodes: 2_000,
+                improve: None,
+            },
+            max_grow: 6,
+            max_cavity_tets: 1500,
+            allow_interior_steiner: false,
+            remove_outside: true,
+        }
+    }
+}
+
+/// Why [`recover`] could not run.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum RecoverError {
+    /// The mesh is malformed (indices, labels, orientation, faces in more than two tets).
+    #[error("invalid mesh: {0}")]
+    InvalidMesh(String),
+    /// The surface's arrays are inconsistent (indices out of range, one side pair per triangle).
+    #[error("invalid surface: {0}")]
+    InvalidSurface(String),
+    /// The mesh's boundary is not convex and its tets are not all tets of the Delaunay
+    /// tetrahedralization of its points, so the space outside it cannot be restored.
+    #[error(
+        "the mesh does not cover the convex hull of its points and is not part of their Delaunay \
+         tetrahedralization: {0}"
+    )]
+    NotCovering(String),
+}
+
+/// How the mesh was made to cover its domain.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum Domain {
+    /// The mesh boundary was convex: used as given.
+    Convex,
+    /// Outside tets had been removed; the Delaunay tets of the points were put back first.
+    DelaunayCompleted {
+        /// Tets put back.
+        tets_added: usize,
+    },
+}
+
+/// A surface triangle that could not be recovered.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Unrecovered {
+    /// Index in the surface.
+    pub triangle: usize,
+    /// Its corners.
+    pub corners: [P3; 3],
+    /// Its smallest angle in degrees (a very small one is the usual root cause).
+    pub min_angle_deg: f64,
+    /// Why the last attempt failed.
+    pub reason: String,
+}
+
+/// What [`recover`] did.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RecoverReport {
+    /// How the domain was covered.
+    pub domain: Domain,
+    /// Tets of the input mesh.
+    pub tets_before: usize,
+    /// Tets of the output mesh.
+    pub tets_after: usize,
+    /// Surface triangles missing from the input mesh.
+    pub missing_before: usize,
+    /// Surface triangles missing from the output mesh.
+    pub missing_after: usize,
+    /// Cavity fills attempted (LAST RESORT calls, growth attempts included).
+    pub calls: usize,
+    /// Of those, the ones that succeeded.
+    pub calls_succeeded: usize,
+    /// Cavities grown by a ring after a failure.
+    pub cavities_grown: usize,
+    /// Median and largest time of one call, in milliseconds.
+    pub call_ms_median: f64,
+    /// Largest time of one call, in milliseconds.
+    pub call_ms_max: f64,
+    /// Median search nodes visited per call.
+    pub nodes_median: u64,
+    /// Largest search nodes visited by one call.
+    pub nodes_max: u64,
+    /// Total search nodes visited.
+    pub nodes_total: u64,
+    /// Median number of tets carved per call.
+    pub cavity_tets_median: usize,
+    /// Points added strictly inside cavities (only with `allow_interior_steiner`).
+    pub points_added: usize,
+    /// Tets of region 0 removed at the end.
+    pub outside_tets_removed: usize,
+    /// Regions whose surrounding surface triangles disagree about their label (left as they
+    /// were; only when some triangle is unrecovered).
+    pub label_conflicts: usize,
+    /// Total wall time in milliseconds.
+    pub total_ms: f64,
+    /// The triangles still missing.
+    pub unrecovered: Vec<Unrecovered>,
+}
+
+impl RecoverReport {
+    /// True when every surface triangle is a face of the output mesh.
+    pub fn is_complete(&self) -> bool {
+        self.missing_after == 0
+    }
+}
+
+/// Recover every triangle of `surface` in `mesh` (see the module docs). The mesh is modified in
+/// place; its points are kept (with `allow_interior_steiner`, points may be appended, never on
+/// the surface). Returns the report, or an error when the inputs cannot be used.
+pub fn recover(
+    mesh: &mut TetMesh,
+    surface: &SurfaceMesh,
+    opts: &RecoverOptions,
+) -> Result<RecoverReport, RecoverError> {
+    let t0 = Instant::now();
+    validate_inputs(mesh, surface)?;
+    let tets_before = mesh.tets.len();
+    // Surface corners → mesh points.
+    let mut at: FxHashMap<[u64; 3], u32> = FxHashMap::default();
+    at.reserve(mesh.points.len());
+    for (i, p) in mesh.points.iter().enumerate() {
+        at.entry(coord_key(p)).or_insert(i as u32);
+    }
+    let tri_map: Vec<Option<[u32; 3]>> = surface
+        .triangles
+        .iter()
+        .map(|t| {
+            let v = t.map(|i| at.get(&coord_key(&surface.points[i as usize])).copied());
+            match v {
+                [Some(a), Some(b), Some(c)] => Some([a, b, c]),
+                _ => None,
+            }
+        })
+        .collect();
+    drop(at);
+
+    let mut r = Recovery::new(mesh, surface, tri_map, *opts);
+    let missing_before = r.count_missing();
+    let domain = r.cover()?;
+    r.run();
+    if opts.allow_interior_steiner {
+        r.run_steiner();
+    }
+    r.compact();
+    let (removed, conflicts) = r.relabel();
+
+    let mut unrecovered = Vec::new();
+    for (s, m) in r.tri_map.iter().enumerate() {
+        let present = m.is_some_and(|v| r.present(v));
+        if !present {
+            let corners = surface.corners(s);
+            unrecovered.push(Unrecovered {
+                triangle: s,
+                corners,
+                min_angle_deg: min_angle_deg(&corners),
+                reason: r
+                    .reason
+                    .get(&(s as u32))
+                    .cloned()
+                    .unwrap_or_else(|| "a corner is not a mesh point".to_string()),
+            });
+        }
+    }
+    let mut ms: Vec<f64> = r.call_ms.clone();
+    ms.sort_by(f64::total_cmp);
+    let mut nodes = r.call_nodes.clone();
+    nodes.sort_unstable();
+    let mut sizes = r.call_sizes.clone();
+    sizes.sort_unstable();
+    let report = RecoverReport {
+        domain,
+        tets_before,
+        tets_after: r.mesh.tets.len(),
+        missing_before,
+        missing_after: unrecovered.len(),
+        calls: r.call_ms.len(),
+        calls_succeeded: r.calls_ok,
+        cavities_grown: r.grown,
+        call_ms_median: ms.get(ms.len() / 2).copied().unwrap_or(0.0),
+        call_ms_max: ms.last().copied().unwrap_or(0.0),
+        nodes_median: nodes.get(nodes.len() / 2).copied().unwrap_or(0),
+        nodes_max: nodes.last().copied().unwrap_or(0),
+        nodes_total: nodes.iter().sum(),
+        cavity_tets_median: sizes.get(sizes.len() / 2).copied().unwrap_or(0),
+        points_added: r.points_added,
+        outside_tets_removed: removed,
+        label_conflicts: conflicts,
+        total_ms: t0.elapsed().as_secs_f64() * 1e3,
+        unrecovered,
+    };
+    Ok(report)
+}
+
+#[inline]
+fn coord_key(p: &P3) -> [u64; 3] {
+    p.map(|c| if c == 0.0 { 0 } else { c.to_bits() })
+}
+
+fn validate_inputs(mesh: &mut TetMesh, surface: &SurfaceMesh) -> Result<(), RecoverError> {
+    let np = mesh.points.len();
+    if mesh.labels.len() != mesh.tets.len() {
+        return Err(RecoverError::InvalidMesh(format!(
+            "{} labels for {} tets",
+            mesh.labels.len(),
+            mesh.tets.len()
+        )));
+    }
+    if mesh.tets.len() >= 1 << 30 || np >= 1 << 31 {
+        return Err(RecoverError::InvalidMesh("too large".into()));
+    }
+    for (i, p) in mesh.points.iter().enumerate() {
+        if !p.iter().all(|&c| in_exact_range(c)) {
+            return Err(RecoverError::InvalidMesh(format!(
+                "point {i} is not finite or outside the exact range"
+            )));
+        }
+    }
+    for (t, v) in mesh.tets.iter().enumerate() {
+        if v.iter().any(|&i| i as usize >= np) {
+            return Err(RecoverError::InvalidMesh(format!(
+                "tet {t} has a vertex out of range"
+            )));
+        }
+        let c = v.map(|i| mesh.points[i as usize]);
+        if orient3d(c[0], c[1], c[2], c[3]) != Sign::Positive {
+            return Err(RecoverError::InvalidMesh(format!(
+                "tet {t} is not positively oriented"
+            )));
+        }
+    }
+    if mesh.rebuild_neighbors() > 0 {
+        return Err(RecoverError::InvalidMesh(
+            "a face is shared by more than two tets".into(),
+        ));
+    }
+    if surface.sides.len() != surface.triangles.len() {
+        return Err(RecoverError::InvalidSurface(format!(
+            "{} side pairs for {} triangles",
+            surface.sides.len(),
+            surface.triangles.len()
+        )));
+    }
+    let ns = surface.points.len();
+    if surface
+        .triangles
+        .iter()
+        .flatten()
+        .any(|&i| i as usize >= ns)
+    {
+        return Err(RecoverError::InvalidSurface(
+            "a triangle corner is out of range".into(),
+        ));
+    }
+    Ok(())
+}
+
+/// The recovery state: the mesh with dead slots, incidences and statistics.
+struct Recovery<'a> {
+    mesh: &'a mut TetMesh,
+    surface: &'a SurfaceMesh,
+    opts: RecoverOptions,
+    /// Surface triangles in mesh point numbers (`None`: a corner is no mesh point).
+    tri_map: Vec<Option<[u32; 3]>>,
+    alive: Vec<bool>,
+    free: Vec<u32>,
+    vert_tets: Vec<Vec<u32>>,
+    /// Surface triangles at each mesh point.
+    surf_at: Vec<Vec<u32>>,
+    tet_mark: Vec<u32>,
+    pt_mark: Vec<u32>,
+    pt_local: Vec<u32>,
+    stamp: u32,
+    searcher: Searcher,
+    cells: Cells,
+    reason: FxHashMap<u32, String>,
+    call_ms: Vec<f64>,
+    call_nodes: Vec<u64>,
+    call_sizes: Vec<usize>,
+    calls_ok: usize,
+    grown: usize,
+    points_added: usize,
+}
+
+/// A carved cavity ready to fill.
+#[derive(Default)]
+struct Cavity {
+    tets: Vec<u32>,
+    /// Global point ids, local order.
+    points: Vec<u32>,
+    coords: Vec<P3>,
+    /// Shell faces (global ids, outward from the cavity) with the kept tet across and its face
+    /// (or `NO_NEIGHBOR`).
+    shell: Vec<([u32; 3], u32, u8)>,
+    /// Half-faces in local ids, pointing into their cell.
+    half: Vec<[u32; 3]>,
+}
+
+/// Where a surface triangle lies relative to a cavity.
+enum Place {
+    Inside,
+    Outside,
+    /// In the plane of the listed mesh boundary faces of the cavity (indices into the shell),
+    /// overlapping them; `inward`: its own orientation faces into the cavity.
+    OnBoundary {
+        faces: Vec<usize>,
+        inward: bool,
+    },
+}
+
+enum Failure {
+    /// The missing triangle is not inside the cavity (crosses its shell).
+    NotInside,
+    TooLarge,
+    NoSteiner,
+    Cells,
+    Search(SearchError),
+}
+
+impl Failure {
+    fn describe(&self) -> String {
+        match self {
+            Failure::NotInside => "the triangle leaves the largest cavity tried".into(),
+            Failure::TooLarge => "the cavity grew too large".into(),
+            Failure::NoSteiner => "no interior point could be placed in the cavity".into(),
+            Failure::Cells => "the cavity's constrained faces do not split it into cells".into(),
+            Failure::Search(SearchError::NoFill { .. }) => {
+                "no fill of the cavity exists without new points (search exhausted)".into()
+            }
+            Failure::Search(e) => format!("search failed: {e}"),
+        }
+    }
+}
+
+impl<'a> Recovery<'a> {
+    fn new(
+        mesh: &'a mut TetMesh,
+        surface: &'a SurfaceMesh,
+        tri_map: Vec<Option<[u32; 3]>>,
+        opts: RecoverOptions,
+    ) -> Recovery<'a> {
+        let np = mesh.points.len();
+        let mut surf_at = vec![Vec::new(); np];
+        for (s, m) in tri_map.iter().enumerate() {
+            if let Some(v) = m {
+                for &x in v {
+                    surf_at[x as usize].push(s as u32);
+                }
+            }
+        }
+        let mut r = Recovery {
+            mesh,
+            surface,
+            opts,
+            tri_map,
+            alive: Vec::new(),
+            free: Vec::new(),
+            vert_tets: Vec::new(),
+            surf_at,
+            tet_mark: Vec::new(),
+            pt_mark: vec![0; np],
+            pt_local: vec![0; np],
+            stamp: 0,
+            searcher: Searcher::new(),
+            cells: Cells::default(),
+            reason: FxHashMap::default(),
+            call_ms: Vec::new(),
+            call_nodes: Vec::new(),
+            call_sizes: Vec::new(),
+            calls_ok: 0,
+            grown: 0,
+            points_added: 0,
+        };
+        r.index();
+        r
+    }
+
+    /// Rebuild the incidence lists from scratch.
+    fn index(&mut self) {
+        let np = self.mesh.points.len();
+        self.alive = vec![true; self.mesh.tets.len()];
+        self.free.clear();
+        self.tet_mark = vec![0; self.mesh.tets.len()];
+        self.vert_tets = vec![Vec::new(); np];
+        for (t, v) in self.mesh.tets.iter().enumerate() {
+            for &x in v {
+                self.vert_tets[x as usize].push(t as u32);
+            }
+        }
+    }
+
+    /// Is the triangle a face of a live tet?
+    fn present(&self, v: [u32; 3]) -> bool {
+        self.vert_tets[v[0] as usize].iter().any(|&t| {
+            let tv = self.mesh.tets[t as usize];
+            tv.contains(&v[1]) && tv.contains(&v[2])
+        })
+    }
+
+    fn count_missing(&self) -> usize {
+        self.tri_map
+            .iter()
+            .filter(|m| !m.is_some_and(|v| self.present(v)))
+            .count()
+    }
+
+    /// Make the mesh cover the convex hull of its points (module docs, step 1).
+    fn cover(&mut self) -> Result<Domain, RecoverError> {
+        if boundary_is_convex(self.mesh) {
+            return Ok(Domain::Convex);
+        }
+        let dt = Delaunay::new(&self.mesh.points)
+            .map_err(|e| RecoverError::NotCovering(format!("Delaunay failed: {e}")))?;
+        if dt.n_vertices() != self.mesh.points.len() {
+            return Err(RecoverError::NotCovering("duplicate points".into()));
+        }
+        let full = dt.to_tet_mesh();
+        let key = |t: &[u32; 4]| {
+            let mut k = *t;
+            k.sort_unstable();
+            k
+        };
+        let have: FxHashSet<[u32; 4]> = self.mesh.tets.iter().map(key).collect();
+        let dt_keys: FxHashSet<[u32; 4]> = full.tets.iter().map(key).collect();
+        if let Some(t) = self
+            .mesh
+            .tets
+            .iter()
+            .position(|t| !dt_keys.contains(&key(t)))
+        {
+            return Err(RecoverError::NotCovering(format!(
+                "tet {t} is not a Delaunay tet of the points"
+            )));
+        }
+        let mut added = 0;
+        for t in &full.tets {
+            if !have.contains(&key(t)) {
+                self.mesh.tets.push(*t);
+                self.mesh.labels.push(0);
+                added += 1;
+            }
+        }
+        self.mesh.rebuild_neighbors();
+        self.index();
+        Ok(Domain::DelaunayCompleted { tets_added: added })
+    }
+
+    /// Process the queue of missing triangles (module docs, steps 3–4).
+    fn run(&mut self) {
+        let mut queue: VecDeque<u32> = (0..self.tri_map.len() as u32)
+            .filter(|&s| self.tri_map[s as usize].is_some_and(|v| !self.present(v)))
+            .collect();
+        let mut stalled = 0usize;
+        while let Some(s) = queue.pop_front() {
+            let Some(v) = self.tri_map[s as usize] else {
+                continue;
+            };
+            if self.present(v) {
+                continue;
+            }
+            if stalled > queue.len() {
+                queue.push_front(s);
+                break;
+            }
+            if self.attempt(s, v, None) {
+                stalled = 0;
+                self.reason.remove(&s);
+            } else {
+                stalled += 1;
+                queue.push_back(s);
+            }
+        }
+    }
+
+    /// One triangle: the cavity of its corners, grown on failure.
+    fn attempt(&mut self, s: u32, v: [u32; 3], steiner: Option<()>) -> bool {
+        // The tets around the corners.
+        self.stamp += 1;
+        let st = self.stamp;
+        let mut tets = Vec::new();
+        for &c in &v {
+            for &t in &self.vert_tets[c as usize] {
+                if self.tet_mark[t as usize] != st {
+                    self.tet_mark[t as usize] = st;
+                    tets.push(t);
+                }
+            }
+        }
+        for ring in 0..=self.opts.max_grow {
+            if ring > 0 {
+                self.grown += 1;
+                self.grow(&mut tets);
+            }
+            if tets.len() > self.opts.max_cavity_tets {
+                self.reason.insert(s, Failure::TooLarge.describe());
+                break;
+            }
+            match self.carve_and_fill(v, &tets, steiner.is_some()) {
+                Ok(()) => return true,
+                Err(f) => {
+                    self.reason.insert(s, f.describe());
+                }
+            }
+        }
+        false
+    }
+
+    /// Add the next ring: every tet across a face of the cavity.
+    fn grow(&mut self, tets: &mut Vec<u32>) {
+        self.stamp += 1;
+        let st = self.stamp;
+        for &t in tets.iter() {
+            self.tet_mark[t as usize] = st;
+        }
+        let n = tets.len();
+        for i in 0..n {
+            for &nb in &self.mesh.neighbors[tets[i] as usize] {
+                if nb != NO_NEIGHBOR && self.tet_mark[nb as usize] != st {
+                    self.tet_mark[nb as usize] = st;
+                    tets.push(nb);
+                }
+            }
+        }
+    }
+
+    /// Carve the tets `tets`, fill the cavity, and insert the fill.
+    fn carve_and_fill(&mut self, m: [u32; 3], tets: &[u32], steiner: bool) -> Result<(), Failure> {
+        let start = Instant::now();
+        let mut nodes = 0u64;
+        let n0 = self.mesh.points.len();
+        let mut cav = Cavity::default();
+        let result = self
+            .carve(m, tets, &mut cav, steiner)
+            .and_then(|()| self.fill_cells(&mut cav, &mut nodes));
+        let ok = match result {
+            Ok(new_tets) => {
+                self.insert(&cav, &new_tets);
+                self.calls_ok += 1;
+                Ok(())
+            }
+            Err(f) => {
+                self.drop_unused_points(n0);
+                Err(f)
+            }
+        };
+        self.call_ms.push(start.elapsed().as_secs_f64() * 1e3);
+        self.call_nodes.push(nodes);
+        self.call_sizes.push(cav.tets.len());
+        ok
+    }
+
+    fn carve(
+        &mut self,
+        m: [u32; 3],
+        tets: &[u32],
+        cav: &mut Cavity,
+        steiner: bool,
+    ) -> Result<(), Failure> {
+        self.stamp += 1;
+        let st = self.stamp;
+        for &t in tets {
+            self.tet_mark[t as usize] = st;
+        }
+        cav.tets.extend_from_slice(tets);
+        for &t in &cav.tets {
+            for &x in &self.mesh.tets[t as usize] {
+                if self.pt_mark[x as usize] != st {
+                    self.pt_mark[x as usize] = st;
+                    self.pt_local[x as usize] = cav.points.len() as u32;
+                    cav.points.push(x);
+                    cav.coords.push(self.mesh.points[x as usize]);
+                }
+            }
+        }
+        let mut shell_keys: FxHashSet<[u32; 3]> = FxHashSet::default();
+        for &t in &cav.tets {
+            for f in 0..4 {
+                let n = self.mesh.neighbors[t as usize][f];
+                if n == NO_NEIGHBOR || self.tet_mark[n as usize] != st {
+                    let g = self.mesh.face(t as usize, f);
+                    let nf = if n == NO_NEIGHBOR {
+                        0
+                    } else {
+                        self.mesh.neighbors[n as usize]
+                            .iter()
+                            .position(|&x| x == t)
+                            .unwrap_or(0) as u8
+                    };
+                    cav.shell.push((g, n, nf));
+                    shell_keys.insert(sorted3(g));
+                    let l = g.map(|x| self.pt_local[x as usize]);
+                    cav.half.push([l[0], l[2], l[1]]);
+                }
+            }
+        }
+        // Constrained faces.
+        let mut dropped = vec![false; cav.shell.len()];
+        let mut seen: FxHashSet<u32> = FxHashSet::default();
+        let mut found_m = false;
+        let mkey = sorted3(m);
+        for &x in &cav.points {
+            for &s in &self.surf_at[x as usize] {
+                if !seen.insert(s) {
+                    continue;
+                }
+                let Some(v) = self.tri_map[s as usize] else {
+                    continue;
+                };
+                if v.iter().any(|&y| self.pt_mark[y as usize] != st) {
+                    continue;
+                }
+                let key = sorted3(v);
+                if shell_keys.contains(&key) {
+                    continue;
+                }
+                let place = if self.interior_face(v, st) {
+                    Place::Inside
+                } else {
+                    self.inside_cavity(v, cav, st)
+                };
+                let l = v.map(|y| self.pt_local[y as usize]);
+                match place {
+                    Place::Outside => {
+                        if key == mkey {
+                            return Err(Failure::NotInside);
+                        }
+                        continue;
+                    }
+                    Place::Inside => {
+                        cav.half.push(l);
+                        cav.half.push([l[0], l[2], l[1]]);
+                    }
+                    Place::OnBoundary { faces, inward } => {
+                        for k in faces {
+                            dropped[k] = true;
+                        }
+                        cav.half.push(if inward { l } else { [l[0], l[2], l[1]] });
+                    }
+                }
+                if key == mkey {
+                    found_m = true;
+                }
+            }
+        }
+        if dropped.iter().any(|&d| d) {
+            // Boundary faces re-triangulated by surface triangles in their plane.
+            let mut i = 0;
+            cav.half.retain(|_| {
+                i += 1;
+                dropped.get(i - 1).is_none_or(|&d| !d)
+            });
+        }
+        if !found_m {
+            return Err(Failure::NotInside);
+        }
+        if steiner {
+            self.add_steiner(cav)?;
+        }
+        Ok(())
+    }
+
+    /// Is `v` a face between two tets of the cavity?
+    fn interior_face(&self, v: [u32; 3], st: u32) -> bool {
+        let mut n = 0;
+        for &t in &self.vert_tets[v[0] as usize] {
+            let tv = self.mesh.tets[t as usize];
+            if tv.contains(&v[1]) && tv.contains(&v[2]) {
+                if self.tet_mark[t as usize] != st {
+                    return false;
+                }
+                n += 1;
+            }
+        }
+        n == 2
+    }
+
+    /// Does triangle `v` (corners in the cavity) lie inside the cavity? Exact: no improper
+    /// contact with any shell face, so its open part is entirely inside or entirely outside;
+    /// then the point `x = u + ε(w − u) + δ(v − u)` (0 < δ ≪ ε infinitesimal, inside the
+    /// triangle next to corner `u`) is located in the carved tets at `u`. The orientation of `x`
+    /// against a plane is the first non-zero of its orientations of `u`, `w`, `v`.
+    ///
+    /// A triangle in the plane of mesh boundary faces of the cavity (a surface triangle on the
+    /// convex hull, split differently) is [`Place::OnBoundary`]: those faces are replaced by it.
+    fn inside_cavity(&self, v: [u32; 3], cav: &Cavity, st: u32) -> Place {
+        let tp = v.map(|x| self.mesh.points[x as usize]);
+        let (mut lo, mut hi) = (tp[0], tp[0]);
+        for p in &tp[1..] {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        let mut on_boundary = Vec::new();
+        for (i, (g, n, _)) in cav.shell.iter().enumerate() {
+            let gp = g.map(|x| self.mesh.points[x as usize]);
+            if (0..3).any(|k| gp.iter().all(|p| p[k] < lo[k]) || gp.iter().all(|p| p[k] > hi[k])) {
+                continue;
+            }
+            if tri_tri(&tp, &gp) == TriTri::Improper {
+                let coplanar = tp
+                    .iter()
+                    .all(|&p| orient3d(gp[0], gp[1], gp[2], p) == Sign::Zero);
+                if *n == NO_NEIGHBOR && coplanar {
+                    on_boundary.push(i);
+                    continue;
+                }
+                return Place::Outside;
+            }
+        }
+        if let Some(&i) = on_boundary.first() {
+            // Orient it like the boundary faces seen from inside: towards the cavity tet's apex.
+            let g = cav.shell[i].0;
+            let apex = cav.tets.iter().find_map(|&t| {
+                let tv = self.mesh.tets[t as usize];
+                let inside = g.iter().all(|x| tv.contains(x));
+                inside.then(|| tv.into_iter().find(|x| !g.contains(x)))?
+            });
+            let Some(apex) = apex else {
+                return Place::Outside;
+            };
+            let inward =
+                orient3d(tp[0], tp[1], tp[2], self.mesh.points[apex as usize]) == Sign::Positive;
+            return Place::OnBoundary {
+                faces: on_boundary,
+                inward,
+            };
+        }
+        let [u, vv, w] = tp;
+        for &t in &self.vert_tets[v[0] as usize] {
+            if self.tet_mark[t as usize] != st {
+                continue;
+            }
+            let c = self.mesh.corners(t as usize);
+            let inside = TET_FACES.iter().all(|f| {
+                let (a, b, cc) = (c[f[0]], c[f[1]], c[f[2]]);
+                let mut s = orient3d(a, b, cc, u);
+                if s == Sign::Zero {
+                    s = orient3d(a, b, cc, w);
+                }
+                if s == Sign::Zero {
+                    s = orient3d(a, b, cc, vv);
+                }
+                s != Sign::Positive
+            });
+            if inside {
+                return Place::Inside;
+            }
+        }
+        Place::Outside
+    }
+
+    /// Split into cells and search each; the new tets in global numbering.
+    fn fill_cells(&mut self, cav: &mut Cavity, nodes: &mut u64) -> Result<Vec<[u32; 4]>, Failure> {
+        let mut cell = Vec::new();
+        let n = self
+            .cells
+            .split(&cav.coords, &cav.half, &mut cell)
+            .map_err(|_| Failure::Cells)?;
+        let mut on_face = vec![false; cav.points.len()];
+        for f in &cav.half {
+            for &x in f {
+                on_face[x as usize] = true;
+            }
+        }
+        let inner: Vec<u32> = (0..cav.points.len() as u32)
+            .filter(|&x| !on_face[x as usize])
+            .collect();
+        let mut out = Vec::new();
+        let mut faces = Vec::new();
+        for c in 0..n as u32 {
+            faces.clear();
+            faces.extend(
+                cav.half
+                    .iter()
+                    .zip(&cell)
+                    .filter(|(_, k)| **k == c)
+                    .map(|(f, _)| *f),
+            );
+            match self
+                .searcher
+                .fill(&cav.coords, &faces, &inner, &self.opts.search)
+            {
+                Ok(f) => {
+                    *nodes += f.nodes_visited;
+                    out.extend(f.tets.iter().map(|t| t.map(|x| cav.points[x as usize])));
+                }
+                Err(e) => {
+                    if let SearchError::NoFill { nodes_visited }
+                    | SearchError::Budget { nodes_visited } = e
+                    {
+                        *nodes += nodes_visited;
+                    }
+                    return Err(Failure::Search(e));
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// Replace the cavity's tets by `new_tets`, keeping adjacency.
+    fn insert(&mut self, cav: &Cavity, new_tets: &[[u32; 4]]) {
+        // Provisional label: the most common label of the carved tets.
+        let mut labels: Vec<u32> = cav
+            .tets
+            .iter()
+            .map(|&t| self.mesh.labels[t as usize])
+            .collect();
+        labels.sort_unstable();
+        let mut label = labels.first().copied().unwrap_or(1);
+        let mut best = 0;
+        let mut i = 0;
+        while i < labels.len() {
+            let mut j = i;
+            while j < labels.len() && labels[j] == labels[i] {
+                j += 1;
+            }
+            if j - i > best {
+                best = j - i;
+                label = labels[i];
+            }
+            i = j;
+        }
+        for &t in &cav.tets {
+            self.alive[t as usize] = false;
+            for &x in &self.mesh.tets[t as usize] {
+                let l = &mut self.vert_tets[x as usize];
+                if let Some(p) = l.iter().position(|&y| y == t) {
+                    l.swap_remove(p);
+                }
+            }
+            self.free.push(t);
+        }
+        let mut slots = Vec::with_capacity(new_tets.len());
+        for t in new_tets {
+            let slot = if let Some(s) = self.free.pop() {
+                self.mesh.tets[s as usize] = *t;
+                self.mesh.labels[s as usize] = label;
+                self.mesh.neighbors[s as usize] = [NO_NEIGHBOR; 4];
+                self.alive[s as usize] = true;
+                s
+            } else {
+                self.mesh.tets.push(*t);
+                self.mesh.labels.push(label);
+                self.mesh.neighbors.push([NO_NEIGHBOR; 4]);
+                self.alive.push(true);
+                self.tet_mark.push(0);
+                (self.mesh.tets.len() - 1) as u32
+            };
+            for &x in t {
+                self.vert_tets[x as usize].push(slot);
+            }
+            slots.push(slot);
+        }
+        // Adjacency: among the new tets, then across the shell.
+        let mut open: FxHashMap<[u32; 3], (u32, u8)> = FxHashMap::default();
+        for &s in &slots {
+            for f in 0..4 {
+                let key = sorted3(self.mesh.face(s as usize, f));
+                if let Some((o, of)) = open.remove(&key) {
+                    self.mesh.neighbors[s as usize][f] = o;
+                    self.mesh.neighbors[o as usize][of as usize] = s;
+                } else {
+                    open.insert(key, (s, f as u8));
+                }
+            }
+        }
+        for (g, n, nf) in &cav.shell {
+            if let Some((s, f)) = open.remove(&sorted3(*g)) {
+                self.mesh.neighbors[s as usize][f as usize] = *n;
+                if *n != NO_NEIGHBOR {
+                    self.mesh.neighbors[*n as usize][*nf as usize] = s;
+                }
+            }
+        }
+    }
+
+    /// Put one point strictly inside the cavity: the average of the cavity's points, when it
+    /// lies strictly inside a carved tet and on no surface triangle (exact tests).
+    fn add_steiner(&mut self, cav: &mut Cavity) -> Result<(), Failure> {
+        let n = cav.coords.len().max(1) as f64;
+        let mut p = [0.0; 3];
+        for c in &cav.coords {
+            for k in 0..3 {
+                p[k] += c[k] / n;
+            }
+        }
+        let strictly = cav.tets.iter().any(|&t| {
+            let c = self.mesh.corners(t as usize);
+            TET_FACES
+                .iter()
+                .all(|f| orient3d(c[f[0]], c[f[1]], c[f[2]], p) == Sign::Negative)
+        });
+        if !strictly || !p.iter().all(|&x| in_exact_range(x)) || self.on_surface(p) {
+            return Err(Failure::NoSteiner);
+        }
+        let id = self.mesh.points.len() as u32;
+        // A cavity point now; removed again by `carve_and_fill` if the fill fails.
+        self.mesh.points.push(p);
+        self.vert_tets.push(Vec::new());
+        self.surf_at.push(Vec::new());
+        self.pt_mark.push(self.stamp);
+        self.pt_local.push(cav.points.len() as u32);
+        cav.points.push(id);
+        cav.coords.push(p);
+        Ok(())
+    }
+
+    /// Whether `p` lies on a surface triangle (exact).
+    fn on_surface(&self, p: P3) -> bool {
+        (0..self.surface.triangles.len()).any(|s| {
+            let c = self.surface.corners(s);
+            if (0..3).any(|k| c.iter().all(|q| q[k] < p[k]) || c.iter().all(|q| q[k] > p[k])) {
+                return false;
+            }
+            crate::geom::intersect::seg_tri(p, p, &c).meets()
+        })
+    }
+
+    /// Last resort: the failed triangles again, each cavity with one interior point.
+    fn run_steiner(&mut self) {
+        let todo: Vec<u32> = (0..self.tri_map.len() as u32)
+            .filter(|&s| self.tri_map[s as usize].is_some_and(|v| !self.present(v)))
+            .collect();
+        for s in todo {
+            let Some(v) = self.tri_map[s as usize] else {
+                continue;
+            };
+            if self.present(v) {
+                continue;
+            }
+            let n0 = self.mesh.points.len();
+            if self.attempt(s, v, Some(())) {
+                self.points_added += self.mesh.points.len() - n0;
+                self.reason.remove(&s);
+            }
+        }
+    }
+
+    /// Remove points appended after `n0` that no tet uses (failed Steiner tries), from the end.
+    fn drop_unused_points(&mut self, n0: usize) {
+        while self.mesh.points.len() > n0 {
+            let last = self.mesh.points.len() - 1;
+            if !self.vert_tets[last].is_empty() {
+                break;
+            }
+            self.mesh.points.pop();
+            self.vert_tets.pop();
+            self.surf_at.pop();
+            self.pt_mark.pop();
+            self.pt_local.pop();
+        }
+    }
+
+    /// Drop dead slots and rebuild adjacency.
+    fn compact(&mut self) {
+        let mut k = 0;
+        for t in 0..self.mesh.tets.len() {
+            if self.alive[t] {
+                self.mesh.tets[k] = self.mesh.tets[t];
+                self.mesh.labels[k] = self.mesh.labels[t];
+                k += 1;
+            }
+        }
+        self.mesh.tets.truncate(k);
+        self.mesh.labels.truncate(k);
+        self.mesh.rebuild_neighbors();
+        self.index();
+    }
+
+    /// Flood-fill region labels from the surface's side labels and remove region 0. Returns
+    /// (tets removed, regions with conflicting votes).
+    fn relabel(&mut self) -> (usize, usize) {
+        let mut wall: FxHashMap<[u32; 3], u32> = FxHashMap::default();
+        let mut on_surface = vec![false; self.mesh.points.len()];
+        for (s, m) in self.tri_map.iter().enumerate() {
+            if let Some(v) = m {
+                wall.insert(sorted3(*v), s as u32);
+                for &x in v {
+                    on_surface[x as usize] = true;
+                }
+            }
+        }
+        let n = self.mesh.tets.len();
+        let mut comp = vec![u32::MAX; n];
+        let mut conflicts = 0;
+        let mut stack = Vec::new();
+        let mut members = Vec::new();
+        for seed in 0..n {
+            if comp[seed] != u32::MAX {
+                continue;
+            }
+            comp[seed] = seed as u32;
+            stack.push(seed as u32);
+            members.clear();
+            let mut vote: Option<u32> = None;
+            let mut conflict = false;
+            while let Some(t) = stack.pop() {
+                members.push(t);
+                for f in 0..4 {
+                    let g = self.mesh.face(t as usize, f);
+                    if g.iter().all(|&x| on_surface[x as usize])
+                        && let Some(&s) = wall.get(&sorted3(g))
+                        && let Some(v) = self.tri_map[s as usize]
+                    {
+                        let behind = same_cyclic(g, v);
+                        let sides = self.surface.sides[s as usize];
+                        let l = if behind { sides[0] } else { sides[1] };
+                        match vote {
+                            None => vote = Some(l),
+                            Some(x) if x != l => conflict = true,
+                            _ => {}
+                        }
+                        continue;
+                    }
+                    let nb = self.mesh.neighbors[t as usize][f];
+                    if nb != NO_NEIGHBOR && comp[nb as usize] == u32::MAX {
+                        comp[nb as usize] = seed as u32;
+                        stack.push(nb);
+                    }
+                }
+            }
+            if conflict {
+                conflicts += 1;
+            } else if let Some(l) = vote {
+                for &t in &members {
+                    self.mesh.labels[t as usize] = l;
+                }
+            }
+        }
+        if !self.opts.remove_outside {
+            return (0, conflicts);
+        }
+        let removed = self.remove_outside();
+        (removed, conflicts)
+    }
+
+    /// Remove the tets labelled 0.
+    fn remove_outside(&mut self) -> usize {
+        let before = self.mesh.tets.len();
+        let mut k = 0;
+        for t in 0..before {
+            if self.mesh.labels[t] != 0 {
+                self.mesh.tets[k] = self.mesh.tets[t];
+                self.mesh.labels[k] = self.mesh.labels[t];
+                k += 1;
+            }
+        }
+        self.mesh.tets.truncate(k);
+        self.mesh.labels.truncate(k);
+        self.mesh.rebuild_neighbors();
+        self.index();
+        before - k
+    }
+}
+
+/// Smallest angle of a 3D triangle, in degrees (0 for a degenerate one).
+fn min_angle_deg(c: &[P3; 3]) -> f64 {
+    (0..3)
+        .map(|k| {
+            let (a, b, o) = (c[(k + 1) % 3], c[(k + 2) % 3], c[k]);
+            let (u, v) = (sub(a, o), sub(b, o));
+            norm(cross(u, v)).atan2(dot(u, v)).to_degrees()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Same three vertices in the same cyclic order.
+fn same_cyclic(a: [u32; 3], b: [u32; 3]) -> bool {
+    (0..3).any(|r| a == [b[r], b[(r + 1) % 3], b[(r + 2) % 3]])
+}
+
+/// Whether the mesh boundary is a closed surface that is convex at every edge (exact): then it
+/// bounds the convex hull of its points. A mesh without boundary faces is not convex.
+fn boundary_is_convex(mesh: &TetMesh) -> bool {
+    let faces: Vec<[u32; 3]> = mesh
+        .boundary_faces()
+        .map(|(t, f)| mesh.face(t, f))
+        .collect();
+    if faces.is_empty() {
+        return false;
+    }
+    let mut edges: FxHashMap<(u32, u32), u32> = FxHashMap::default();
+    for (i, f) in faces.iter().enumerate() {
+        for k in 0..3 {
+            edges.insert((f[k], f[(k + 1) % 3]), i as u32);
+        }
+    }
+    for f in &faces {
+        for k in 0..3 {
+            let (a, b) = (f[k], f[(k + 1) % 3]);
+            let Some(&j) = edges.get(&(b, a)) else {
+                return false;
+            };
+            let g = faces[j as usize];
+            let Some(&d) = g.iter().find(|&&x| x != a && x != b) else {
+                return false;
+            };
+            let p = f.map(|x| mesh.points[x as usize]);
+            if orient3d(p[0], p[1], p[2], mesh.points[d as usize]) == Sign::Positive {
+                return false;
+            }
+        }
+    }
+    true
+}

@@ -1,0 +1,1076 @@
+//! The LAST RESORT search (Algorithm 3.1 of the seed, section 3.3.1): fill a closed cavity shell
+//! with tets whose corners are cavity points only.
+//!
+//! # What is searched
+//! The *front* starts as the shell: oriented triangles whose right-hand normals point into the
+//! region to fill (a triangle may appear with both orientations: a "fin" inside the region, such
+//! as a recovered surface triangle that the rest of the shell does not close off). A candidate of
+//! an active face `abc` is a tet `abcp` whose fourth point `p` is a cavity point with
+//! 1. `orient3d(a, b, c, p) > 0` (exact);
+//! 2. quality `q` (eq. 4.9) above the threshold ηe (floating point: ranking only; with ηe ≤ 0
+//!    no float test is made at all);
+//! 3. no other live cavity point in the closed tet (exact, orient3d);
+//! 4. no improper contact with any other active face: for every active face and every face of
+//!    the tet, the exact triangle–triangle test ([`tri_tri`]) reports disjoint, a shared vertex
+//!    or a shared edge, or the two are the same triangle.
+//!
+//! Given 3 for both tets, 4 is exactly "the tet lies in the closure of the unfilled region and
+//! meets its boundary only in shared vertices, edges and faces": if an active face met the open
+//! tet, its corners being outside it, some pair of faces would meet improperly. The unfilled
+//! region only shrinks, so a candidate once invalid stays invalid down the tree: candidates are
+//! computed once per face and only *filtered* when a tet is added (the same pairwise test against
+//! the new tet), and filtering is undone on backtracking.
+//!
+//! # How
+//! Every fill has exactly one tet on each active face, so branching over the candidates of one
+//! face is exhaustive. The face with the fewest live candidates is expanded (a face with none
+//! prunes the branch at once, fig. 3.5); candidates are tried best quality first; a dead end
+//! returns to the previous level (fig. 3.6). This is the seed's search made complete: the seed
+//! tries the best tet of successive faces, which can miss fills.
+//!
+//! With [`SearchOptions::improve`] the search goes on after the first fill, branch and bound on
+//! the worst quality so far (candidates not better than the best fill's worst tet are pruned),
+//! until the tree is exhausted or the extra node budget is spent.
+//!
+//! # Limits
+//! Exponential in the worst case (the seed's eq. 3.3); [`SearchOptions::max_nodes`] bounds the
+//! work and [`SearchError::Budget`] reports it. A shell without a fill (the Schönhardt
+//! polyhedron) is proved fillless only when the tree is exhausted within the budget
+//! ([`SearchError::NoFill`]).
+
+use crate::geom::filter::orient3d;
+use crate::geom::intersect::{TriTri, is_degenerate, seg_tri, tri_tri};
+use crate::geom::predicates::{Sign, in_exact_range};
+use crate::quality::tet::q_measure;
+use rustc_hash::FxHashMap;
+use std::cell::Cell;
+use thiserror::Error;
+
+type P3 = [f64; 3];
+
+/// Options of [`fill`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SearchOptions {
+    /// ηe: candidates need quality q (eq. 4.9) strictly above it. At or below 0, every
+    /// positively oriented tet qualifies (decided exactly, no float test).
+    pub min_quality: f64,
+    /// Node budget for the first fill.
+    pub max_nodes: u64,
+    /// After the first fill, look for fills with a better worst tet for at most this many more
+    /// nodes (branch and bound). `None`: stop at the first fill.
+    pub improve: Option<u64>,
+}
+
+impl Default for SearchOptions {
+    fn default() -> Self {
+        SearchOptions {
+            min_quality: 0.0,
+            max_nodes: 100_000,
+            improve: None,
+        }
+    }
+}
+
+/// A fill found by [`fill`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Fill {
+    /// The tets, positively oriented, as indices into the caller's point array.
+    pub tets: Vec<[u32; 4]>,
+    /// The smallest quality q among them.
+    pub worst_q: f64,
+    /// Search nodes visited (tets tried).
+    pub nodes_visited: u64,
+    /// With [`SearchOptions::improve`]: true when the whole tree was searched, so no fill has a
+    /// better worst tet (among tets above ηe).
+    pub optimal: bool,
+}
+
+/// Why [`fill`] found no fill.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum SearchError {
+    /// The shell has no triangles.
+    #[error("the shell is empty")]
+    Empty,
+    /// A shell or inner point index is out of range.
+    #[error("point index {index} is out of range ({n} points)")]
+    IndexOutOfRange {
+        /// The index.
+        index: u32,
+        /// Number of points.
+        n: usize,
+    },
+    /// A point used by the shell is not finite or outside the predicates' exact range.
+    #[error("point {index} is not finite or outside the exact range of the predicates")]
+    BadCoordinate {
+        /// The point.
+        index: u32,
+    },
+    /// Two distinct indices have the same coordinates.
+    #[error("points {a} and {b} have the same coordinates")]
+    DuplicatePoint {
+        /// First index.
+        a: u32,
+        /// Second index.
+        b: u32,
+    },
+    /// A shell triangle has collinear or repeated corners.
+    #[error("shell triangle {face} is degenerate")]
+    DegenerateFace {
+        /// Index in the shell.
+        face: usize,
+    },
+    /// Some directed edge `a → b` is used more often than `b → a`: the shell is not closed and
+    /// consistently oriented.
+    #[error("the shell is not closed: edge {a}->{b} is unmatched")]
+    NotClosed {
+        /// Edge start.
+        a: u32,
+        /// Edge end.
+        b: u32,
+    },
+    /// The whole tree was searched: no fill with these points and threshold exists.
+    #[error("no fill exists (search exhausted after {nodes_visited} nodes)")]
+    NoFill {
+        /// Nodes visited.
+        nodes_visited: u64,
+    },
+    /// The node budget ran out before a fill was found.
+    #[error("node budget exhausted after {nodes_visited} nodes")]
+    Budget {
+        /// Nodes visited.
+        nodes_visited: u64,
+    },
+}
+
+/// Fill the closed shell `shell` (triangles of indices into `points`, normals pointing into the
+/// region) plus the isolated points `inner` with tets (see the module docs).
+///
+/// Every point of `inner` strictly inside the region ends up as a tet corner (a fill may not
+/// contain a cavity point); points outside it are simply not used.
+pub fn fill(
+    points: &[P3],
+    shell: &[[u32; 3]],
+    inner: &[u32],
+    opts: &SearchOptions,
+) -> Result<Fill, SearchError> {
+    Searcher::default().fill(points, shell, inner, opts)
+}
+
+/// An active face of the front.
+#[derive(Debug, Clone, Copy)]
+struct Face {
+    v: [u32; 3],
+    alive: bool,
+    /// Candidate range in `Searcher::cands`.
+    c0: u32,
+    c1: u32,
+    /// Live candidates.
+    live: u32,
+}
+
+/// A candidate tet `face + p`.
+#[derive(Debug, Clone, Copy)]
+struct Cand {
+    p: u32,
+    q: f64,
+    dead: bool,
+    lo: P3,
+    hi: P3,
+}
+
+/// Undo record of one search level.
+#[derive(Debug, Clone, Copy)]
+struct Level {
+    faces_len: u32,
+    cands_len: u32,
+    kill_len: u32,
+    removed_len: u32,
+    tet: [u32; 4],
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Flow {
+    Continue,
+    Done,
+    Abort,
+}
+
+/// The search with its buffers, reusable across calls (no allocation once warm).
+#[derive(Debug, Default)]
+pub struct Searcher {
+    pts: Vec<P3>,
+    global: Vec<u32>,
+    faces: Vec<Face>,
+    cands: Vec<Cand>,
+    map: FxHashMap<[u32; 3], u32>,
+    kill_log: Vec<u32>,
+    removed_log: Vec<u32>,
+    front_deg: Vec<u32>,
+    uses: Vec<u32>,
+    levels: Vec<Level>,
+    worst: Vec<f64>,
+    best: Vec<[u32; 4]>,
+    best_worst: f64,
+    have_best: bool,
+    bound: f64,
+    nodes: u64,
+    budget: u64,
+    eta: f64,
+    improve: Option<u64>,
+    scratch: Vec<[u32; 3]>,
+    edges: Vec<(u32, u32)>,
+    /// Cached orientations of every point against every face's plane, face-major
+    /// ([`UNKNOWN`] until computed).
+    sides: Vec<Cell<i8>>,
+    /// Orientations against the three new faces of the current candidate, stamped.
+    raw: Vec<Cell<(u32, i8)>>,
+    raw_stamp: Cell<u32>,
+    /// Per edge of the face whose candidates are computed: the apex of the one other front face
+    /// across it, and that face, when the region's wedge there is convex.
+    wedge: [Option<u32>; 3],
+}
+
+/// Marks a not yet computed entry of `Searcher::sides`.
+const UNKNOWN: i8 = 2;
+
+/// A face plane of a tet, oriented outwards: a front face's (cached, possibly flipped) or a
+/// plain triangle's.
+#[derive(Debug, Clone, Copy)]
+enum Plane {
+    Face(u32, bool),
+    /// A plain triangle, its orientations cached in slot `k` (0..3) of the current candidate.
+    Tri(usize, [u32; 3]),
+}
+
+/// Canonical rotation of an oriented triangle (smallest index first).
+#[inline]
+fn canon(f: [u32; 3]) -> [u32; 3] {
+    if f[0] < f[1] && f[0] < f[2] {
+        f
+    } else if f[1] < f[2] {
+        [f[1], f[2], f[0]]
+    } else {
+        [f[2], f[0], f[1]]
+    }
+}
+
+#[inline]
+fn same_set(a: [u32; 3], b: [u32; 3]) -> bool {
+    a.iter().all(|x| b.contains(x))
+}
+
+#[inline]
+fn bbox4(c: &[P3; 4]) -> (P3, P3) {
+    let mut lo = c[0];
+    let mut hi = c[0];
+    for p in &c[1..] {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    (lo, hi)
+}
+
+#[inline]
+fn boxes_apart(alo: P3, ahi: P3, blo: P3, bhi: P3) -> bool {
+    (0..3).any(|k| ahi[k] < blo[k] || bhi[k] < alo[k])
+}
+
+/// The four outward faces of tet `t` (the face table of [`crate::TET_FACES`]).
+#[inline]
+fn tet_faces(t: [u32; 4]) -> [[u32; 3]; 4] {
+    [
+        [t[1], t[2], t[3]],
+        [t[0], t[3], t[2]],
+        [t[0], t[1], t[3]],
+        [t[0], t[2], t[1]],
+    ]
+}
+
+impl Searcher {
+    /// A searcher with empty buffers.
+    pub fn new() -> Searcher {
+        Searcher::default()
+    }
+
+    /// [`fill`], reusing this searcher's buffers.
+    pub fn fill(
+        &mut self,
+        points: &[P3],
+        shell: &[[u32; 3]],
+        inner: &[u32],
+        opts: &SearchOptions,
+    ) -> Result<Fill, SearchError> {
+        self.load(points, shell, inner)?;
+        self.eta = opts.min_quality;
+        self.improve = opts.improve;
+        self.budget = opts.max_nodes;
+        self.nodes = 0;
+        self.have_best = false;
+        self.best.clear();
+        self.best_worst = f64::NEG_INFINITY;
+        self.bound = f64::NEG_INFINITY;
+        self.levels.clear();
+        self.worst.clear();
+        self.worst.push(f64::INFINITY);
+        for f in 0..self.faces.len() {
+            self.gen_candidates(f);
+        }
+        let flow = self.dfs();
+        if self.have_best {
+            let tets = self
+                .best
+                .iter()
+                .map(|t| t.map(|v| self.global[v as usize]))
+                .collect();
+            return Ok(Fill {
+                tets,
+                worst_q: self.best_worst,
+                nodes_visited: self.nodes,
+                optimal: flow == Flow::Continue,
+            });
+        }
+        match flow {
+            Flow::Abort => Err(SearchError::Budget {
+                nodes_visited: self.nodes,
+            }),
+            _ => Err(SearchError::NoFill {
+                nodes_visited: self.nodes,
+            }),
+        }
+    }
+
+    /// Validate the input and set up local points and the initial front.
+    fn load(
+        &mut self,
+        points: &[P3],
+        shell: &[[u32; 3]],
+        inner: &[u32],
+    ) -> Result<(), SearchError> {
+        if shell.is_empty() {
+            return Err(SearchError::Empty);
+        }
+        let n = points.len();
+        self.global.clear();
+        for &i in shell.iter().flatten().chain(inner) {
+            if i as usize >= n {
+                return Err(SearchError::IndexOutOfRange { index: i, n });
+            }
+            self.global.push(i);
+        }
+        self.global.sort_unstable();
+        self.global.dedup();
+        self.pts.clear();
+        for &g in &self.global {
+            let p = points[g as usize];
+            if !p.iter().all(|&c| in_exact_range(c)) {
+                return Err(SearchError::BadCoordinate { index: g });
+            }
+            self.pts.push(p);
+        }
+        // Duplicates: sort local ids by coordinates.
+        let mut order: Vec<u32> = (0..self.pts.len() as u32).collect();
+        let key = |p: &P3| p.map(|c| if c == 0.0 { 0 } else { c.to_bits() });
+        order.sort_unstable_by_key(|&i| key(&self.pts[i as usize]));
+        for w in order.windows(2) {
+            if key(&self.pts[w[0] as usize]) == key(&self.pts[w[1] as usize]) {
+                return Err(SearchError::DuplicatePoint {
+                    a: self.global[w[0] as usize],
+                    b: self.global[w[1] as usize],
+                });
+            }
+        }
+        let local = |g: u32, global: &[u32]| global.binary_search(&g).unwrap_or(0) as u32;
+        self.scratch.clear();
+        for (i, f) in shell.iter().enumerate() {
+            let l = f.map(|g| local(g, &self.global));
+            let c = l.map(|v| self.pts[v as usize]);
+            if l[0] == l[1] || l[1] == l[2] || l[0] == l[2] || is_degenerate(&c) {
+                return Err(SearchError::DegenerateFace { face: i });
+            }
+            self.scratch.push(l);
+        }
+        // Closed: every directed edge matched by its reverse.
+        self.edges.clear();
+        for f in &self.scratch {
+            for k in 0..3 {
+                self.edges.push((f[k], f[(k + 1) % 3]));
+            }
+        }
+        self.edges.sort_unstable();
+        let count = |e: &[(u32, u32)], x: (u32, u32)| {
+            let lo = e.partition_point(|y| *y < x);
+            e[lo..].iter().take_while(|y| **y == x).count()
+        };
+        for &(a, b) in &self.edges {
+            if count(&self.edges, (a, b)) != count(&self.edges, (b, a)) {
+                return Err(SearchError::NotClosed {
+                    a: self.global[a as usize],
+                    b: self.global[b as usize],
+                });
+            }
+        }
+        let np = self.pts.len();
+        self.front_deg.clear();
+        self.front_deg.resize(np, 0);
+        self.uses.clear();
+        self.uses.resize(np, 0);
+        self.raw.clear();
+        self.raw.resize(3 * np, Cell::new((0, 0)));
+        self.raw_stamp.set(1);
+        self.faces.clear();
+        self.cands.clear();
+        self.map.clear();
+        self.kill_log.clear();
+        self.removed_log.clear();
+        let scratch = std::mem::take(&mut self.scratch);
+        for &f in &scratch {
+            if self.map.contains_key(&canon(f)) {
+                // The same oriented triangle twice: the region would be on one side twice.
+                return Err(SearchError::NotClosed {
+                    a: self.global[f[0] as usize],
+                    b: self.global[f[1] as usize],
+                });
+            }
+            self.push_face(f);
+        }
+        self.scratch = scratch;
+        Ok(())
+    }
+
+    fn push_face(&mut self, v: [u32; 3]) {
+        let id = self.faces.len() as u32;
+        let c = self.cands.len() as u32;
+        self.faces.push(Face {
+            v,
+            alive: true,
+            c0: c,
+            c1: c,
+            live: 0,
+        });
+        self.map.insert(canon(v), id);
+        for &x in &v {
+            self.front_deg[x as usize] += 1;
+        }
+        let np = self.pts.len();
+        let row = id as usize * np;
+        if self.sides.len() < row + np {
+            self.sides.resize_with(row + np, || Cell::new(UNKNOWN));
+        }
+        for c in &self.sides[row..row + np] {
+            c.set(UNKNOWN);
+        }
+    }
+
+    fn kill_face(&mut self, f: u32) {
+        let face = &mut self.faces[f as usize];
+        face.alive = false;
+        let v = face.v;
+        self.map.remove(&canon(v));
+        for &x in &v {
+            self.front_deg[x as usize] -= 1;
+        }
+        self.removed_log.push(f);
+    }
+
+    #[inline]
+    fn usable(&self, p: u32) -> bool {
+        self.front_deg[p as usize] > 0 || self.uses[p as usize] == 0
+    }
+
+    /// Exact orientation of point `d` against the plane of `abc`, zero at once when `d` is one
+    /// of `a, b, c` (no adaptive stage for the exact zero).
+    #[inline]
+    fn o(&self, a: u32, b: u32, c: u32, d: u32) -> Sign {
+        if d == a || d == b || d == c {
+            return Sign::Zero;
+        }
+        let p = &self.pts;
+        orient3d(p[a as usize], p[b as usize], p[c as usize], p[d as usize])
+    }
+
+    /// [`Self::o`] against the plane of face `f`, cached per face and point.
+    #[inline]
+    fn side(&self, f: u32, x: u32) -> Sign {
+        let cell = &self.sides[f as usize * self.pts.len() + x as usize];
+        match cell.get() {
+            1 => Sign::Positive,
+            -1 => Sign::Negative,
+            0 => Sign::Zero,
+            _ => {
+                let v = self.faces[f as usize].v;
+                let s = self.o(v[0], v[1], v[2], x);
+                cell.set(s.as_i32() as i8);
+                s
+            }
+        }
+    }
+
+    /// Orientation of `x` against plane `pl`, positive outside the tet.
+    #[inline]
+    fn outer(&self, pl: Plane, x: u32) -> Sign {
+        match pl {
+            Plane::Face(f, flip) => self.side(f, x).times(!flip),
+            Plane::Tri(k, v) => {
+                let cell = &self.raw[k * self.pts.len() + x as usize];
+                let (st, val) = cell.get();
+                if st == self.raw_stamp.get() {
+                    return match val {
+                        1 => Sign::Positive,
+                        -1 => Sign::Negative,
+                        _ => Sign::Zero,
+                    };
+                }
+                let s = self.o(v[0], v[1], v[2], x);
+                cell.set((self.raw_stamp.get(), s.as_i32() as i8));
+                s
+            }
+        }
+    }
+
+    /// Is `other` on the closed outer side of plane `pl` (face `fv`), touching it only at
+    /// corners of `fv`? Then the two meet at most in shared corners of that face.
+    #[inline]
+    fn separates(&self, pl: Plane, fv: [u32; 3], other: &[u32]) -> bool {
+        other.iter().all(|&x| match self.outer(pl, x) {
+            Sign::Positive => true,
+            Sign::Zero => fv.contains(&x),
+            Sign::Negative => false,
+        })
+    }
+
+    /// Do the triangles `f` (plane `fpl`) and `g` (plane `gpl`), distinct vertex sets, meet
+    /// other than in shared corners or a shared edge? Exact. Plane tests (cached orientations)
+    /// settle the common cases; triangles without a shared corner are decided by their edges
+    /// (for triangles in different planes, they meet iff an edge of one meets the other);
+    /// coplanar pairs and pairs with one shared corner go to [`tri_tri`].
+    fn tri_conflict(&self, f: [u32; 3], fpl: Plane, g: [u32; 3], gpl: Plane) -> bool {
+        let sg = g.map(|x| {
+            if f.contains(&x) {
+                Sign::Zero
+            } else {
+                self.outer(fpl, x)
+            }
+        });
+        let sf = f.map(|x| {
+            if g.contains(&x) {
+                Sign::Zero
+            } else {
+                self.outer(gpl, x)
+            }
+        });
+        let one_side = |s: &[Sign; 3], v: [u32; 3], other: [u32; 3]| {
+            let mut pos = false;
+            let mut neg = false;
+            for k in 0..3 {
+                if other.contains(&v[k]) {
+                    continue;
+                }
+                match s[k] {
+                    Sign::Positive => pos = true,
+                    Sign::Negative => neg = true,
+                    Sign::Zero => return false,
+                }
+            }
+            !(pos && neg)
+        };
+        if one_side(&sg, g, f) || one_side(&sf, f, g) {
+            return false;
+        }
+        let shared = g.iter().filter(|x| f.contains(x)).count();
+        let coplanar = sg.iter().all(|&x| x == Sign::Zero);
+        if shared == 0 && !coplanar {
+            return (0..3).any(|k| self.seg_meets(f[k], f[(k + 1) % 3], sf[k], sf[(k + 1) % 3], g))
+                || (0..3).any(|k| self.seg_meets(g[k], g[(k + 1) % 3], sg[k], sg[(k + 1) % 3], f));
+        }
+        let fp = f.map(|x| self.pts[x as usize]);
+        let gp = g.map(|x| self.pts[x as usize]);
+        tri_tri(&fp, &gp) == TriTri::Improper
+    }
+
+    /// Does segment `xy` meet the closed triangle `t` (no corner shared)? `sx`, `sy`: the
+    /// orientations of `x`, `y` against `t`'s plane (in any one sign convention).
+    fn seg_meets(&self, x: u32, y: u32, sx: Sign, sy: Sign, t: [u32; 3]) -> bool {
+        if sx != Sign::Zero && sx == sy {
+            return false;
+        }
+        let p = &self.pts;
+        let tp = t.map(|i| p[i as usize]);
+        if sx == Sign::Zero && sy == Sign::Zero {
+            return seg_tri(p[x as usize], p[y as usize], &tp).meets();
+        }
+        // The line crosses the plane at one point; its barycentric signs are the orientations
+        // of the line against the triangle's edges, times the sign of its direction · normal.
+        let ox = self.o(t[0], t[1], t[2], x);
+        let oy = self.o(t[0], t[1], t[2], y);
+        let dn_positive = oy == Sign::Positive || ox == Sign::Negative;
+        let lam = [
+            self.o4(x, y, t[1], t[2]).times(dn_positive),
+            self.o4(x, y, t[2], t[0]).times(dn_positive),
+            self.o4(x, y, t[0], t[1]).times(dn_positive),
+        ];
+        !lam.contains(&Sign::Negative)
+    }
+
+    /// Plain exact orientation of four distinct points.
+    #[inline]
+    fn o4(&self, a: u32, b: u32, c: u32, d: u32) -> Sign {
+        let p = &self.pts;
+        orient3d(p[a as usize], p[b as usize], p[c as usize], p[d as usize])
+    }
+
+    /// The outward planes of the candidate tet `face + p`.
+    #[inline]
+    fn cand_planes(&self, f: u32, p: u32) -> ([[u32; 3]; 4], [Plane; 4]) {
+        self.raw_stamp.set(self.raw_stamp.get().wrapping_add(1));
+        let v = self.faces[f as usize].v;
+        let tf = tet_faces([v[0], v[1], v[2], p]);
+        (
+            tf,
+            [
+                Plane::Tri(0, tf[0]),
+                Plane::Tri(1, tf[1]),
+                Plane::Tri(2, tf[2]),
+                Plane::Face(f, true),
+            ],
+        )
+    }
+
+    /// Compute the candidates of face `f` (its range is the end of `cands`).
+    fn gen_candidates(&mut self, f: usize) {
+        let v = self.faces[f].v;
+        let [a, b, c] = v.map(|x| self.pts[x as usize]);
+        let start = self.cands.len();
+        self.find_wedges(f as u32);
+        let wedge = self.wedge;
+        'apex: for p in 0..self.pts.len() as u32 {
+            if v.contains(&p) || !self.usable(p) {
+                continue;
+            }
+            if self.side(f as u32, p) != Sign::Positive {
+                continue;
+            }
+            // Convex wedge at an edge: the apex must be in front of the face across it (or be
+            // its apex): else the tet leaves the region next to that edge.
+            for h in wedge.iter().flatten() {
+                let hv = self.faces[*h as usize].v;
+                if !hv.contains(&p) && self.side(*h, p) != Sign::Positive {
+                    continue 'apex;
+                }
+            }
+            let d = self.pts[p as usize];
+            let corners = [a, b, c, d];
+            let q = q_measure(&corners);
+            if (self.eta > 0.0 && q.partial_cmp(&self.eta) != Some(std::cmp::Ordering::Greater))
+                || q <= self.bound
+            {
+                continue;
+            }
+            let (lo, hi) = bbox4(&corners);
+            let (tf, planes) = self.cand_planes(f as u32, p);
+            let t = [v[0], v[1], v[2], p];
+            if self.contains_point(t, &planes, lo, hi)
+                || self.hits_front(t, &tf, &planes, f as u32, lo, hi)
+            {
+                continue;
+            }
+            self.cands.push(Cand {
+                p,
+                q,
+                dead: false,
+                lo,
+                hi,
+            });
+        }
+        self.cands[start..].sort_by(|x, y| y.q.total_cmp(&x.q).then(x.p.cmp(&y.p)));
+        let face = &mut self.faces[f];
+        face.c0 = start as u32;
+        face.c1 = self.cands.len() as u32;
+        face.live = face.c1 - face.c0;
+    }
+
+    /// For each edge of face `f`, the other front face across it when it is the only one and the
+    /// region's wedge between the two is convex (at most flat).
+    fn find_wedges(&mut self, f: u32) {
+        let v = self.faces[f as usize].v;
+        let mut w = [None; 3];
+        let mut count = [0u8; 3];
+        for (h, face) in self.faces.iter().enumerate() {
+            if !face.alive || h as u32 == f {
+                continue;
+            }
+            let hv = face.v;
+            for k in 0..3 {
+                let (a, b) = (v[k], v[(k + 1) % 3]);
+                // The face across runs the edge backwards.
+                if (0..3).any(|i| hv[i] == b && hv[(i + 1) % 3] == a) {
+                    count[k] += 1;
+                    w[k] = Some(h as u32);
+                }
+                if (0..3).any(|i| hv[i] == a && hv[(i + 1) % 3] == b) {
+                    count[k] += 2;
+                }
+            }
+        }
+        for k in 0..3 {
+            self.wedge[k] = None;
+            if count[k] != 1 {
+                continue;
+            }
+            if let Some(h) = w[k] {
+                let hv = self.faces[h as usize].v;
+                let Some(&apex) = hv.iter().find(|&&x| !v.contains(&x)) else {
+                    continue;
+                };
+                if self.side(f, apex) != Sign::Negative {
+                    self.wedge[k] = Some(h);
+                }
+            }
+        }
+    }
+
+    /// Does the closed tet `t` contain a usable point other than its corners?
+    fn contains_point(&self, t: [u32; 4], planes: &[Plane; 4], lo: P3, hi: P3) -> bool {
+        for r in 0..self.pts.len() as u32 {
+            if t.contains(&r) || !self.usable(r) {
+                continue;
+            }
+            let x = self.pts[r as usize];
+            if (0..3).any(|k| x[k] < lo[k] || x[k] > hi[k]) {
+                continue;
+            }
+            // The base plane first: cached.
+            if planes
+                .iter()
+                .rev()
+                .all(|&pl| self.outer(pl, r) != Sign::Positive)
+            {
+                return true;
+            }
+        }
+        false
+    }
+
+    /// Does the candidate tet `t` (built on alive face `base`) meet another active face
+    /// improperly?
+    fn hits_front(
+        &self,
+        t: [u32; 4],
+        tf: &[[u32; 3]; 4],
+        planes: &[Plane; 4],
+        base: u32,
+        lo: P3,
+        hi: P3,
+    ) -> bool {
+        for (g, face) in self.faces.iter().enumerate().rev() {
+            if !face.alive || g as u32 == base {
+                continue;
+            }
+            if self.face_conflicts(t, tf, planes, g as u32, lo, hi) {
+                return true;
+            }
+        }
+        false
+    }
+
+    /// Exact: does front face `gid` meet the candidate tet (corners `t`, outward faces `tf` with
+    /// planes `planes`, the last one its base) other than in shared vertices, edges or whole
+    /// faces?
+    fn face_conflicts(
+        &self,
+        t: [u32; 4],
+        tf: &[[u32; 3]; 4],
+        planes: &[Plane; 4],
+        gid: u32,
+        lo: P3,
+        hi: P3,
+    ) -> bool {
+        let g = self.faces[gid as usize].v;
+        let gp = g.map(|x| self.pts[x as usize]);
+        let mut glo = gp[0];
+        let mut ghi = gp[0];
+        for p in &gp[1..] {
+            for k in 0..3 {
+                glo[k] = glo[k].min(p[k]);
+                ghi[k] = ghi[k].max(p[k]);
+            }
+        }
+        if boxes_apart(lo, hi, glo, ghi) {
+            return false;
+        }
+        if tf.iter().any(|f| same_set(*f, g)) {
+            return false;
+        }
+        // g's plane (cached) with the tet on one closed side, touching only at corners of g.
+        let mut pos = false;
+        let mut neg = false;
+        let mut cut = false;
+        for &x in &t {
+            match self.side(gid, x) {
+                Sign::Positive => pos = true,
+                Sign::Negative => neg = true,
+                Sign::Zero => cut |= !g.contains(&x),
+            }
+        }
+        if !cut && (!pos || !neg) {
+            return false;
+        }
+        // A face plane of the tet with g on its closed outer side.
+        for k in (0..4).rev() {
+            if self.separates(planes[k], tf[k], &g) {
+                return false;
+            }
+        }
+        (0..3).any(|k| self.tri_conflict(tf[k], planes[k], g, Plane::Face(gid, false)))
+    }
+
+    /// Do the candidate tet `c` (outward faces `cf`, planes `cp`) and the new tet (faces `tf`,
+    /// planes `tp`) overlap or meet improperly?
+    #[allow(clippy::too_many_arguments)]
+    fn tets_conflict(
+        &self,
+        c: [u32; 4],
+        cf: &[[u32; 3]; 4],
+        cp: &[Plane; 4],
+        t: [u32; 4],
+        tf: &[[u32; 3]; 4],
+        tp: &[Plane; 4],
+    ) -> bool {
+        if t.iter().all(|x| c.contains(x)) {
+            return true;
+        }
+        if (0..4).any(|k| self.separates(tp[k], tf[k], &c))
+            || (0..4).rev().any(|k| self.separates(cp[k], cf[k], &t))
+        {
+            return false;
+        }
+        for (i, f) in cf.iter().enumerate() {
+            for (k, g) in tf.iter().enumerate() {
+                if !same_set(*f, *g) && self.tri_conflict(*f, cp[i], *g, tp[k]) {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+
+    /// Add the tet of candidate `ci` on face `fi`.
+    fn apply(&mut self, fi: u32, ci: u32) {
+        let face = self.faces[fi as usize];
+        let cand = self.cands[ci as usize];
+        let t = [face.v[0], face.v[1], face.v[2], cand.p];
+        self.levels.push(Level {
+            faces_len: self.faces.len() as u32,
+            cands_len: self.cands.len() as u32,
+            kill_len: self.kill_log.len() as u32,
+            removed_len: self.removed_log.len() as u32,
+            tet: t,
+        });
+        let w = *self.worst.last().unwrap_or(&f64::INFINITY);
+        self.worst.push(w.min(cand.q));
+        self.kill_face(fi);
+        for &x in &t {
+            self.uses[x as usize] += 1;
+        }
+        let tf = tet_faces(t);
+        let mut tp = [Plane::Face(fi, true); 4];
+        let first_new = self.faces.len();
+        for k in 0..3 {
+            let g = tf[k];
+            let rev = [g[0], g[2], g[1]];
+            if let Some(&h) = self.map.get(&canon(rev)) {
+                self.kill_face(h);
+                tp[k] = Plane::Face(h, true);
+            } else {
+                tp[k] = Plane::Face(self.faces.len() as u32, false);
+                self.push_face(g);
+            }
+        }
+        // Filter the candidates of the other live faces against the new tet.
+        let (tlo, thi) = (cand.lo, cand.hi);
+        for f in 0..first_new {
+            let fr = self.faces[f];
+            if !fr.alive || fr.live == 0 {
+                continue;
+            }
+            for k in fr.c0..fr.c1 {
+                let c = self.cands[k as usize];
+                if c.dead || boxes_apart(c.lo, c.hi, tlo, thi) {
+                    continue;
+                }
+                let ct = [fr.v[0], fr.v[1], fr.v[2], c.p];
+                let (cf, cp) = self.cand_planes(f as u32, c.p);
+                if self.tets_conflict(ct, &cf, &cp, t, &tf, &tp) {
+                    self.cands[k as usize].dead = true;
+                    self.faces[f].live -= 1;
+                    self.kill_log.push(k);
+                }
+            }
+        }
+        for f in first_new..self.faces.len() {
+            self.gen_candidates(f);
+        }
+    }
+
+    fn undo(&mut self) {
+        let Some(l) = self.levels.pop() else {
+            return;
+        };
+        self.worst.pop();
+        while self.faces.len() > l.faces_len as usize {
+            if let Some(f) = self.faces.pop() {
+                self.map.remove(&canon(f.v));
+                for &x in &f.v {
+                    self.front_deg[x as usize] -= 1;
+                }
+            }
+        }
+        self.cands.truncate(l.cands_len as usize);
+        while self.kill_log.len() > l.kill_len as usize {
+            if let Some(k) = self.kill_log.pop() {
+                self.cands[k as usize].dead = false;
+                // Find the owning face: the one whose range holds k (alive ones only were
+                // filtered).
+                if let Some(f) = self.owner(k) {
+                    self.faces[f].live += 1;
+                }
+            }
+        }
+        while self.removed_log.len() > l.removed_len as usize {
+            if let Some(f) = self.removed_log.pop() {
+                let face = &mut self.faces[f as usize];
+                face.alive = true;
+                let v = face.v;
+                self.map.insert(canon(v), f);
+                for &x in &v {
+                    self.front_deg[x as usize] += 1;
+                }
+            }
+        }
+        for &x in &l.tet {
+            self.uses[x as usize] -= 1;
+        }
+    }
+
+    /// The face whose candidate range holds candidate `k` (ranges are disjoint and increasing).
+    fn owner(&self, k: u32) -> Option<usize> {
+        let i = self.faces.partition_point(|f| f.c1 <= k);
+        (i < self.faces.len() && self.faces[i].c0 <= k).then_some(i)
+    }
+
+    fn dfs(&mut self) -> Flow {
+        self.nodes += 1;
+        if self.nodes > self.budget {
+            return Flow::Abort;
+        }
+        let mut pick = None;
+        let mut fewest = u32::MAX;
+        for (f, face) in self.faces.iter().enumerate() {
+            if !face.alive {
+                continue;
+            }
+            let n = if self.bound > f64::NEG_INFINITY {
+                (face.c0..face.c1)
+                    .filter(|&k| {
+                        let c = &self.cands[k as usize];
+                        !c.dead && c.q > self.bound
+                    })
+                    .count() as u32
+            } else {
+                face.live
+            };
+            if n == 0 {
+                return Flow::Continue;
+            }
+            if n < fewest {
+                fewest = n;
+                pick = Some(f);
+            }
+        }
+        let Some(f) = pick else {
+            // The front is empty: a fill.
+            let w = *self.worst.last().unwrap_or(&f64::INFINITY);
+            if !self.have_best || w > self.best_worst {
+                self.best.clear();
+                self.best.extend(self.levels.iter().map(|l| l.tet));
+                self.best_worst = w;
+                if !self.have_best {
+                    self.have_best = true;
+                    match self.improve {
+                        None => return Flow::Done,
+                        Some(extra) => self.budget = self.nodes.saturating_add(extra),
+                    }
+                }
+                self.bound = w;
+            }
+            return Flow::Continue;
+        };
+        let face = self.faces[f];
+        for k in face.c0..face.c1 {
+            let c = self.cands[k as usize];
+            if c.dead {
+                continue;
+            }
+            if c.q <= self.bound {
+                break;
+            }
+            self.apply(f as u32, k);
+            let r = self.dfs();
+            self.undo();
+            if r != Flow::Continue {
+                return r;
+            }
+        }
+        Flow::Continue
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The plane-and-edge triangle test agrees with the exact [`tri_tri`] on lattice triangles,
+    /// shared corners included.
+    #[test]
+    fn tri_conflict_matches_tri_tri() {
+        // All points of a small lattice, indexed.
+        let mut pts = Vec::new();
+        for x in -1..=1 {
+            for y in -1..=1 {
+                for z in -1..=1 {
+                    pts.push([x as f64, y as f64, z as f64 * 0.5 + (x * y) as f64 * 0.25]);
+                }
+            }
+        }
+        let mut s = Searcher::new();
+        s.pts = pts.clone();
+        s.raw = vec![Cell::new((0, 0)); 3 * pts.len()];
+        s.raw_stamp.set(1);
+        let n = pts.len() as u64;
+        let mut seed = 12345u64;
+        let mut next = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 33) % n) as u32
+        };
+        let mut checked = 0;
+        while checked < 20000 {
+            let f = [next(), next(), next()];
+            let g = [next(), next(), next()];
+            let fp = f.map(|i| pts[i as usize]);
+            let gp = g.map(|i| pts[i as usize]);
+            if f[0] == f[1] || f[1] == f[2] || f[0] == f[2] || g[0] == g[1] || g[1] == g[2] {
+                continue;
+            }
+            if g[0] == g[2] || is_degenerate(&fp) || is_degenerate(&gp) || same_set(f, g) {
+                continue;
+            }
+            s.raw_stamp.set(s.raw_stamp.get() + 1);
+            let got = s.tri_conflict(f, Plane::Tri(0, f), g, Plane::Tri(1, g));
+            assert_eq!(got, tri_tri(&fp, &gp) == TriTri::Improper, "{f:?} {g:?}");
+            checked += 1;
+        }
+    }
+}

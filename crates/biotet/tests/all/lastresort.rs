@@ -1,0 +1,656 @@
+//! LAST RESORT: the search on unit shells, and boundary recovery on Delaunay meshes of real
+//! surfaces.
+
+use biotet::geom::predicates::{Sign, orient3d};
+use biotet::lastresort::{SearchError, SearchOptions, fill};
+use biotet::quality::tet::{q_measure, volume};
+
+type P3 = [f64; 3];
+
+/// Signed volume enclosed by an oriented closed shell (normals pointing inwards give a negative
+/// sum of outward volumes, so negate).
+fn shell_volume_inward(points: &[P3], shell: &[[u32; 3]]) -> f64 {
+    let o = [0.0; 3];
+    -shell
+        .iter()
+        .map(|f| {
+            volume(&[
+                o,
+                points[f[0] as usize],
+                points[f[1] as usize],
+                points[f[2] as usize],
+            ])
+        })
+        .sum::<f64>()
+}
+
+/// Every tet positive, the tets' faces pair up except the shell's (each shell face is the face
+/// of exactly one tet, seen from inside), volumes add up, every point used.
+fn assert_fills(points: &[P3], shell: &[[u32; 3]], inner: &[u32], tets: &[[u32; 4]]) {
+    use std::collections::HashMap;
+    let faces = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
+    let mut count: HashMap<[u32; 3], i32> = HashMap::new();
+    let canon = |f: [u32; 3]| {
+        let m = (0..3).min_by_key(|&k| f[k]).unwrap();
+        [f[m], f[(m + 1) % 3], f[(m + 2) % 3]]
+    };
+    let mut vol = 0.0;
+    for t in tets {
+        let c = t.map(|i| points[i as usize]);
+        assert_eq!(
+            orient3d(c[0], c[1], c[2], c[3]),
+            Sign::Positive,
+            "tet {t:?}"
+        );
+        vol += volume(&c);
+        for f in faces {
+            let g = [t[f[0]], t[f[1]], t[f[2]]];
+            let rev = canon([g[0], g[2], g[1]]);
+            if let Some(n) = count.get_mut(&rev) {
+                *n -= 1;
+                if *n == 0 {
+                    count.remove(&rev);
+                }
+            } else {
+                *count.entry(canon(g)).or_default() += 1;
+            }
+        }
+    }
+    // What is left are the tets' outward faces on the shell: the shell faces reversed.
+    let mut want: HashMap<[u32; 3], i32> = HashMap::new();
+    for f in shell {
+        *want.entry(canon([f[0], f[2], f[1]])).or_default() += 1;
+    }
+    assert_eq!(count, want, "the fill's boundary is the shell");
+    let v0 = shell_volume_inward(points, shell);
+    assert!(
+        (vol - v0).abs() <= 1e-9 * v0.abs().max(1.0),
+        "{vol} vs {v0}"
+    );
+    for &i in inner {
+        assert!(
+            tets.iter().any(|t| t.contains(&i)),
+            "inner point {i} unused"
+        );
+    }
+}
+
+fn cube() -> (Vec<P3>, Vec<[u32; 3]>) {
+    let pts: Vec<P3> = (0..8)
+        .map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64])
+        .collect();
+    // Quads counter-clockwise seen from inside.
+    let quads = [
+        [0, 1, 3, 2],
+        [4, 6, 7, 5],
+        [0, 4, 5, 1],
+        [2, 3, 7, 6],
+        [0, 2, 6, 4],
+        [1, 5, 7, 3],
+    ];
+    let mut tris = Vec::new();
+    for q in quads {
+        tris.push([q[0], q[1], q[2]]);
+        tris.push([q[0], q[2], q[3]]);
+    }
+    (pts, tris)
+}
+
+#[test]
+fn search_fills_cube() {
+    let (pts, shell) = cube();
+    let f = fill(&pts, &shell, &[], &SearchOptions::default()).unwrap();
+    assert_fills(&pts, &shell, &[], &f.tets);
+    assert!(f.tets.len() == 5 || f.tets.len() == 6, "{}", f.tets.len());
+    assert!(f.worst_q > 0.0);
+    println!(
+        "cube: {} tets, {} nodes, worst q {:.3}",
+        f.tets.len(),
+        f.nodes_visited,
+        f.worst_q
+    );
+}
+
+#[test]
+fn search_fills_cube_with_inner_point() {
+    let (mut pts, shell) = cube();
+    pts.push([0.4, 0.55, 0.45]);
+    let f = fill(&pts, &shell, &[8], &SearchOptions::default()).unwrap();
+    assert_fills(&pts, &shell, &[8], &f.tets);
+    // A point outside the shell is not used.
+    pts.push([3.0, 0.5, 0.5]);
+    let f = fill(&pts, &shell, &[8, 9], &SearchOptions::default()).unwrap();
+    assert_fills(&pts, &shell, &[8], &f.tets);
+    assert!(f.tets.iter().all(|t| !t.contains(&9)));
+}
+
+#[test]
+fn search_fills_octahedron() {
+    let pts: Vec<P3> = vec![
+        [1.0, 0.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+    ];
+    // Outward faces, then reversed to point inwards.
+    let out = [
+        [0, 2, 4],
+        [2, 1, 4],
+        [1, 3, 4],
+        [3, 0, 4],
+        [2, 0, 5],
+        [1, 2, 5],
+        [3, 1, 5],
+        [0, 3, 5],
+    ];
+    let shell: Vec<[u32; 3]> = out.iter().map(|f| [f[0], f[2], f[1]]).collect();
+    let f = fill(&pts, &shell, &[], &SearchOptions::default()).unwrap();
+    assert_fills(&pts, &shell, &[], &f.tets);
+    assert_eq!(f.tets.len(), 4);
+}
+
+/// A triangular prism whose top is turned by `twist` degrees; the side quads are split by the
+/// short diagonals (`short`: the side edges fold outwards and the prism stays convex) or the
+/// long ones (they fold inwards, reflex: the Schönhardt polyhedron for a 30° twist). Faces point
+/// inwards.
+fn twisted_prism(twist: f64, short: bool) -> (Vec<P3>, Vec<[u32; 3]>) {
+    let mut pts = Vec::new();
+    for z in 0..2 {
+        for i in 0..3 {
+            let a = (90.0 + 120.0 * i as f64 + if z == 1 { twist } else { 0.0 }).to_radians();
+            pts.push([a.cos(), a.sin(), z as f64]);
+        }
+    }
+    // Outward: bottom (0, 2, 1), top (3, 4, 5); side i: a_i a_{i+1} b_{i+1} b_i.
+    let mut out = vec![[0u32, 2, 1], [3, 4, 5]];
+    for i in 0..3u32 {
+        let (a0, a1, b0, b1) = (i, (i + 1) % 3, 3 + i, 3 + (i + 1) % 3);
+        if short {
+            out.push([a0, a1, b0]);
+            out.push([a1, b1, b0]);
+        } else {
+            out.push([a0, a1, b1]);
+            out.push([a0, b1, b0]);
+        }
+    }
+    let shell = out.iter().map(|f| [f[0], f[2], f[1]]).collect();
+    (pts, shell)
+}
+
+#[test]
+fn search_fills_twisted_prism() {
+    for twist in [10.0, 30.0, 50.0] {
+        let (pts, shell) = twisted_prism(twist, true);
+        let f = fill(&pts, &shell, &[], &SearchOptions::default()).unwrap();
+        assert_fills(&pts, &shell, &[], &f.tets);
+    }
+}
+
+#[test]
+fn schoenhardt_has_no_fill() {
+    let (pts, shell) = twisted_prism(30.0, false);
+    // Every candidate of every face is blocked: the root has a face without candidates.
+    let e = fill(&pts, &shell, &[], &SearchOptions::default()).unwrap_err();
+    assert!(matches!(e, SearchError::NoFill { .. }), "{e}");
+    // With a point at the centre it fills.
+    let mut pts = pts;
+    pts.push([0.0, 0.0, 0.5]);
+    let f = fill(&pts, &shell, &[6], &SearchOptions::default()).unwrap();
+    assert_fills(&pts, &shell, &[6], &f.tets);
+}
+
+#[test]
+fn search_improves_worst_quality() {
+    // A cube with an inner point: the first fill and the branch-and-bound fill.
+    let (mut pts, shell) = cube();
+    pts.push([0.3, 0.6, 0.45]);
+    let first = fill(&pts, &shell, &[8], &SearchOptions::default()).unwrap();
+    let opts = SearchOptions {
+        improve: Some(1_000_000),
+        ..SearchOptions::default()
+    };
+    let best = fill(&pts, &shell, &[8], &opts).unwrap();
+    assert_fills(&pts, &shell, &[8], &best.tets);
+    assert!(best.optimal);
+    assert!(best.worst_q >= first.worst_q);
+    let worst = best
+        .tets
+        .iter()
+        .map(|t| q_measure(&t.map(|i| pts[i as usize])))
+        .fold(f64::INFINITY, f64::min);
+    assert_eq!(worst, best.worst_q);
+    // A threshold at the optimum leaves no fill.
+    let e = fill(
+        &pts,
+        &shell,
+        &[8],
+        &SearchOptions {
+            min_quality: best.worst_q,
+            ..SearchOptions::default()
+        },
+    )
+    .unwrap_err();
+    assert!(matches!(e, SearchError::NoFill { .. }));
+}
+
+#[test]
+fn search_rejects_bad_input() {
+    let (pts, mut shell) = cube();
+    assert!(matches!(
+        fill(&pts, &shell[1..], &[], &SearchOptions::default()),
+        Err(SearchError::NotClosed { .. })
+    ));
+    assert!(matches!(
+        fill(&pts, &shell, &[99], &SearchOptions::default()),
+        Err(SearchError::IndexOutOfRange { .. })
+    ));
+    assert!(matches!(
+        fill(&pts, &[], &[], &SearchOptions::default()),
+        Err(SearchError::Empty)
+    ));
+    let mut dup = pts.clone();
+    dup.push(pts[0]);
+    assert!(matches!(
+        fill(&dup, &shell, &[8], &SearchOptions::default()),
+        Err(SearchError::DuplicatePoint { .. })
+    ));
+    shell[0] = [0, 1, 1];
+    assert!(matches!(
+        fill(&pts, &shell, &[], &SearchOptions::default()),
+        Err(SearchError::DegenerateFace { .. })
+    ));
+    let mut nan = pts.clone();
+    nan[0][0] = f64::NAN;
+    assert!(matches!(
+        fill(&nan, &cube().1, &[], &SearchOptions::default()),
+        Err(SearchError::BadCoordinate { .. })
+    ));
+}
+
+/// SplitMix64 points in the unit cube.
+fn random_points(n: usize, mut seed: u64) -> Vec<P3> {
+    let mut next = move || {
+        seed = seed.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = seed;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    (0..n).map(|_| [next(), next(), next()]).collect()
+}
+
+#[test]
+fn search_refills_delaunay_cavities() {
+    // Carve the tets around a few vertices of a random Delaunay mesh and fill the cavity again:
+    // a fill exists (the carved tets), the search must find one.
+    use biotet::delaunay::Delaunay;
+    let pts = random_points(2000, 7);
+    let mesh = Delaunay::new(&pts).unwrap().to_tet_mesh();
+    let mut total_nodes = 0;
+    let mut calls = 0;
+    for centre in (0..2000u32).step_by(97) {
+        // The star of `centre` and of its first neighbour.
+        let first: Vec<u32> = (0..mesh.tets.len() as u32)
+            .filter(|&t| mesh.tets[t as usize].contains(&centre))
+            .collect();
+        let other = mesh.tets[first[0] as usize]
+            .iter()
+            .copied()
+            .find(|&v| v != centre)
+            .unwrap();
+        let cavity: Vec<usize> = (0..mesh.tets.len())
+            .filter(|&t| mesh.tets[t].contains(&centre) || mesh.tets[t].contains(&other))
+            .collect();
+        let mut shell = Vec::new();
+        for &t in &cavity {
+            for f in 0..4 {
+                let n = mesh.neighbors[t][f];
+                if n == biotet::NO_NEIGHBOR || !cavity.contains(&(n as usize)) {
+                    let g = mesh.face(t, f);
+                    shell.push([g[0], g[2], g[1]]);
+                }
+            }
+        }
+        let mut inner: Vec<u32> = cavity.iter().flat_map(|&t| mesh.tets[t]).collect();
+        inner.sort_unstable();
+        inner.dedup();
+        inner.retain(|v| !shell.iter().any(|f| f.contains(v)));
+        let f = fill(&mesh.points, &shell, &inner, &SearchOptions::default()).unwrap();
+        assert_fills(&mesh.points, &shell, &inner, &f.tets);
+        total_nodes += f.nodes_visited;
+        calls += 1;
+    }
+    println!("{calls} cavities, {total_nodes} nodes");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Boundary recovery
+// ---------------------------------------------------------------------------------------------
+
+use biotet::check::check;
+use biotet::delaunay::Delaunay;
+use biotet::geom::intersect::{SegTri, seg_tri};
+use biotet::lastresort::{RecoverOptions, recover};
+use biotet::{SurfaceMesh, TetMesh};
+
+/// A tiny binary-STL reader (biotet cannot depend on biotet-io), exact duplicates welded.
+fn read_stl(name: &str) -> SurfaceMesh {
+    let path = format!("{}/../../tests/data/{name}", env!("CARGO_MANIFEST_DIR"));
+    let bytes = std::fs::read(path).expect("read STL");
+    let n = u32::from_le_bytes(bytes[80..84].try_into().unwrap()) as usize;
+    assert_eq!(bytes.len(), 84 + 50 * n, "binary STL size");
+    let f = |o: usize| f32::from_le_bytes(bytes[o..o + 4].try_into().unwrap()) as f64;
+    let mut points = Vec::with_capacity(3 * n);
+    let mut triangles = Vec::with_capacity(n);
+    for t in 0..n {
+        let base = 84 + 50 * t + 12;
+        for c in 0..3 {
+            let o = base + 12 * c;
+            points.push([f(o), f(o + 4), f(o + 8)]);
+        }
+        let i = 3 * t as u32;
+        triangles.push([i, i + 1, i + 2]);
+    }
+    let mut s = SurfaceMesh::closed(points, triangles, 1);
+    s.weld_exact();
+    s
+}
+
+/// Volume enclosed by a closed outward surface.
+fn enclosed_volume(s: &SurfaceMesh) -> f64 {
+    (0..s.triangles.len())
+        .map(|t| {
+            let c = s.corners(t);
+            volume(&[[0.0; 3], c[0], c[1], c[2]])
+        })
+        .sum()
+}
+
+fn mesh_volume(m: &TetMesh) -> f64 {
+    (0..m.tets.len()).map(|t| volume(&m.corners(t))).sum()
+}
+
+/// Point-in-surface by the parity of crossings of the ray towards +z (exact segment–triangle
+/// tests against the segment to a point above the surface); `None` when the ray touches an edge
+/// or vertex (then the caller decides otherwise). Triangles are bucketed on an xy grid.
+struct Inside {
+    s: SurfaceMesh,
+    top: f64,
+    lo: [f64; 2],
+    cell: f64,
+    n: usize,
+    grid: Vec<Vec<u32>>,
+}
+
+impl Inside {
+    fn new(s: &SurfaceMesh) -> Inside {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in &s.points {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        let n = 64;
+        let cell = (hi[0] - lo[0]).max(hi[1] - lo[1]) / n as f64 * 1.0001;
+        let mut grid = vec![Vec::new(); n * n];
+        for t in 0..s.triangles.len() {
+            let c = s.corners(t);
+            let ix = |x: f64, k: usize| (((x - lo[k]) / cell) as usize).min(n - 1);
+            let (x0, x1) = (
+                ix(c.iter().map(|p| p[0]).fold(f64::INFINITY, f64::min), 0),
+                ix(c.iter().map(|p| p[0]).fold(f64::NEG_INFINITY, f64::max), 0),
+            );
+            let (y0, y1) = (
+                ix(c.iter().map(|p| p[1]).fold(f64::INFINITY, f64::min), 1),
+                ix(c.iter().map(|p| p[1]).fold(f64::NEG_INFINITY, f64::max), 1),
+            );
+            for x in x0..=x1 {
+                for y in y0..=y1 {
+                    grid[y * n + x].push(t as u32);
+                }
+            }
+        }
+        Inside {
+            s: s.clone(),
+            top: hi[2] + 1.0,
+            lo: [lo[0], lo[1]],
+            cell,
+            n,
+            grid,
+        }
+    }
+
+    fn contains(&self, p: P3) -> Option<bool> {
+        let ix = ((p[0] - self.lo[0]) / self.cell).floor();
+        let iy = ((p[1] - self.lo[1]) / self.cell).floor();
+        if ix < 0.0 || iy < 0.0 || ix >= self.n as f64 || iy >= self.n as f64 {
+            return Some(false);
+        }
+        let q = [p[0], p[1], self.top];
+        let mut odd = false;
+        for &t in &self.grid[iy as usize * self.n + ix as usize] {
+            match seg_tri(p, q, &self.s.corners(t as usize)) {
+                SegTri::Disjoint => {}
+                SegTri::Proper => odd = !odd,
+                _ => return None,
+            }
+        }
+        Some(odd)
+    }
+}
+
+/// The Delaunay mesh of the surface's points with the tets whose centroid is outside removed.
+fn delaunay_trimmed(s: &SurfaceMesh) -> TetMesh {
+    let dt = Delaunay::new(&s.points).unwrap();
+    let mut m = dt.to_tet_mesh();
+    let inside = Inside::new(s);
+    let keep: Vec<bool> = (0..m.tets.len())
+        .map(|t| {
+            let c = m.corners(t);
+            let g = |w: [f64; 4]| [0, 1, 2].map(|k| (0..4).map(|i| w[i] * c[i][k]).sum::<f64>());
+            // The centroid, or nearby interior points when its ray grazes an edge.
+            [[0.25; 4], [0.3, 0.24, 0.23, 0.23], [0.22, 0.31, 0.26, 0.21]]
+                .iter()
+                .find_map(|&w| inside.contains(g(w)))
+                .unwrap_or(false)
+        })
+        .collect();
+    let mut k = 0;
+    for (t, &kept) in keep.iter().enumerate() {
+        if kept {
+            m.tets[k] = m.tets[t];
+            k += 1;
+        }
+    }
+    m.tets.truncate(k);
+    m.labels.truncate(k);
+    m.rebuild_neighbors();
+    m
+}
+
+fn recover_and_check(name: &str, s: &SurfaceMesh, mut m: TetMesh, opts: &RecoverOptions) {
+    let n_points = m.points.len();
+    let t = std::time::Instant::now();
+    let r = recover(&mut m, s, opts).unwrap();
+    let dt = t.elapsed();
+    println!(
+        "{name}: {:?}, tets {} -> {}, missing {} -> {}, calls {} ({} ok, {} grown), \
+         ms/call median {:.3} max {:.3}, nodes/call median {} max {}, cavity tets median {}, \
+         {:.1} ms total ({dt:.2?})",
+        r.domain,
+        r.tets_before,
+        r.tets_after,
+        r.missing_before,
+        r.missing_after,
+        r.calls,
+        r.calls_succeeded,
+        r.cavities_grown,
+        r.call_ms_median,
+        r.call_ms_max,
+        r.nodes_median,
+        r.nodes_max,
+        r.cavity_tets_median,
+        r.total_ms
+    );
+    for u in r.unrecovered.iter().take(5) {
+        println!("  unrecovered {u:?}");
+    }
+    assert!(r.missing_before > 0);
+    assert!(r.is_complete(), "{} triangles unrecovered", r.missing_after);
+    assert_eq!(m.points.len(), n_points, "no new points");
+    let c = check(&m, Some(s));
+    assert!(c.valid, "{c}");
+    let (v, v0) = (mesh_volume(&m), enclosed_volume(s));
+    assert!((v - v0).abs() < 1e-9 * v0, "volume {v} vs {v0}");
+}
+
+#[test]
+fn recover_brain_delaunay_trimmed() {
+    let s = read_stl("brain_20k.stl");
+    let m = delaunay_trimmed(&s);
+    recover_and_check("brain_20k trimmed", &s, m, &RecoverOptions::default());
+}
+
+#[test]
+fn recover_brain_delaunay_hull() {
+    let s = read_stl("brain_20k.stl");
+    let m = Delaunay::new(&s.points).unwrap().to_tet_mesh();
+    recover_and_check("brain_20k hull", &s, m, &RecoverOptions::default());
+}
+
+#[test]
+fn recover_white_matter_delaunay_trimmed() {
+    let s = read_stl("wm_20k.stl");
+    let m = delaunay_trimmed(&s);
+    recover_and_check("wm_20k trimmed", &s, m, &RecoverOptions::default());
+}
+
+/// A closed outward surface from inward shell faces (reversed), one region.
+fn surface_of(points: &[P3], inward: &[[u32; 3]]) -> SurfaceMesh {
+    SurfaceMesh::closed(
+        points.to_vec(),
+        inward.iter().map(|f| [f[0], f[2], f[1]]).collect(),
+        1,
+    )
+}
+
+/// Recover `s` in the Delaunay mesh of its points (and `extra` points): valid, every triangle.
+fn recover_small(s: &SurfaceMesh, extra: &[P3]) -> biotet::lastresort::RecoverReport {
+    let mut pts = s.points.clone();
+    pts.extend_from_slice(extra);
+    let mut m = Delaunay::new(&pts).unwrap().to_tet_mesh();
+    let r = recover(&mut m, s, &RecoverOptions::default()).unwrap();
+    assert!(r.is_complete(), "{r:?}");
+    let c = check(&m, Some(s));
+    assert!(c.valid, "{c}");
+    let (v, v0) = (mesh_volume(&m), enclosed_volume(s));
+    assert!((v - v0).abs() < 1e-12 * v0.max(1.0), "{v} vs {v0}");
+    r
+}
+
+#[test]
+fn recover_unit_shells() {
+    let (p, f) = cube();
+    let r = recover_small(&surface_of(&p, &f), &[]);
+    println!("cube: missing {}", r.missing_before);
+    // Diagonals the other way than the Delaunay split picks: some must be recovered.
+    let (p, f) = cube();
+    let flipped: Vec<[u32; 3]> = f
+        .chunks(2)
+        .flat_map(|q| {
+            let (a, b) = (q[0], q[1]); // a = [q0 q1 q2], b = [q0 q2 q3]
+            [[a[0], a[1], b[2]], [a[1], a[2], b[2]]]
+        })
+        .collect();
+    let s = surface_of(&p, &flipped);
+    let r = recover_small(&s, &[[0.5, 0.5, 0.5]]);
+    println!("cube, other diagonals: missing {}", r.missing_before);
+    let (p, f) = twisted_prism(30.0, true);
+    recover_small(&surface_of(&p, &f), &[]);
+    // The octahedron with points inside.
+    let pts: Vec<P3> = vec![
+        [1.0, 0.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+    ];
+    let out = [
+        [0, 2, 4],
+        [2, 1, 4],
+        [1, 3, 4],
+        [3, 0, 4],
+        [2, 0, 5],
+        [1, 2, 5],
+        [3, 1, 5],
+        [0, 3, 5],
+    ];
+    let s = SurfaceMesh::closed(pts, out.to_vec(), 1);
+    recover_small(&s, &[[0.1, 0.2, 0.05], [-0.2, 0.1, -0.3]]);
+}
+
+#[test]
+fn recover_fails_honestly_on_schoenhardt() {
+    let (p, f) = twisted_prism(30.0, false);
+    let s = surface_of(&p, &f);
+    let mut m = Delaunay::new(&p).unwrap().to_tet_mesh();
+    let r = recover(&mut m, &s, &RecoverOptions::default()).unwrap();
+    assert!(!r.is_complete());
+    assert_eq!(r.missing_after, r.unrecovered.len());
+    assert!(r.missing_before >= 3);
+    for u in &r.unrecovered {
+        assert!(u.reason.contains("no fill"), "{}", u.reason);
+        assert!(u.min_angle_deg > 0.0);
+        assert_eq!(u.corners, s.corners(u.triangle));
+    }
+    assert_eq!(r.points_added, 0);
+    assert_eq!(m.points.len(), 6);
+    // With one interior point allowed, it is recovered.
+    let mut m = Delaunay::new(&p).unwrap().to_tet_mesh();
+    let opts = RecoverOptions {
+        allow_interior_steiner: true,
+        ..RecoverOptions::default()
+    };
+    let r = recover(&mut m, &s, &opts).unwrap();
+    assert!(r.is_complete(), "{r:?}");
+    assert_eq!(r.points_added, 1);
+    assert_eq!(m.points.len(), 7);
+    let c = check(&m, Some(&s));
+    assert!(c.valid, "{c}");
+}
+
+#[test]
+fn recover_nested_interface_labels() {
+    // Two nested cubes: region 2 inside, region 1 between; the inner surface is an interface.
+    let (p, f) = cube();
+    let mut pts: Vec<P3> = p.iter().map(|x| x.map(|c| c * 3.0)).collect();
+    pts.extend(p.iter().map(|x| x.map(|c| c + 1.0)));
+    let mut tris: Vec<[u32; 3]> = f.iter().map(|t| [t[0], t[2], t[1]]).collect();
+    let mut sides = vec![[1, 0]; tris.len()];
+    tris.extend(f.iter().map(|t| [t[0] + 8, t[2] + 8, t[1] + 8]));
+    sides.extend(std::iter::repeat_n([2, 1], f.len()));
+    let s = SurfaceMesh {
+        points: pts.clone(),
+        triangles: tris,
+        sides,
+    };
+    let mut m = Delaunay::new(&pts).unwrap().to_tet_mesh();
+    let r = recover(&mut m, &s, &RecoverOptions::default()).unwrap();
+    assert!(r.is_complete(), "{r:?}");
+    let c = check(&m, Some(&s));
+    assert!(c.valid, "{c}");
+    assert_eq!(m.regions(), vec![1, 2]);
+    let vol = |l: u32| -> f64 {
+        (0..m.tets.len())
+            .filter(|&t| m.labels[t] == l)
+            .map(|t| volume(&m.corners(t)))
+            .sum()
+    };
+    assert!((vol(2) - 1.0).abs() < 1e-12, "{}", vol(2));
+    assert!((vol(1) - 26.0).abs() < 1e-12, "{}", vol(1));
+}
