@@ -8,6 +8,7 @@ use rustc_hash::{FxHashMap, FxHashSet};
 use serde::Serialize;
 
 use crate::delaunay::{Delaunay, DelaunayError};
+use crate::lastresort::{RecoverError, RecoverOptions, RecoverReport, recover};
 use crate::mesh::inside::{Location, RegionLocator, Transitions};
 use crate::mesh::surface::SurfaceMesh;
 use crate::mesh::tet::{NO_NEIGHBOR, TetMesh};
@@ -20,6 +21,8 @@ use crate::template::{DeployError, DeployOptions, TemplateStats, deploy};
 pub struct PipelineOptions {
     /// Node deployment.
     pub deploy: DeployOptions,
+    /// Boundary recovery (`None` skips it).
+    pub recover: Option<RecoverOptions>,
     /// Smoothing (`None` skips it). Surface nodes stay fixed by default, so the surface is kept
     /// exactly.
     pub smooth: Option<SmoothOptions>,
@@ -29,6 +32,7 @@ impl PipelineOptions {
     /// Node deployment, Delaunay and outside removal only (no later stage).
     pub fn deploy_only() -> PipelineOptions {
         PipelineOptions {
+            recover: None,
             smooth: None,
             ..PipelineOptions::default()
         }
@@ -39,6 +43,7 @@ impl Default for PipelineOptions {
     fn default() -> PipelineOptions {
         PipelineOptions {
             deploy: DeployOptions::default(),
+            recover: Some(RecoverOptions::default()),
             // Clusters already above 0.1 sr are left alone: on brain_20k that halves the time and
             // changes the tets below 10° by 0.1%.
             smooth: Some(SmoothOptions {
@@ -81,6 +86,8 @@ pub struct MeshReport {
     pub n_points: usize,
     /// Input triangles that are not faces of the output mesh.
     pub missing_triangles: usize,
+    /// What boundary recovery did (if it ran).
+    pub recover: Option<RecoverReport>,
     /// What smoothing did (if it ran).
     pub smooth: Option<SmoothReport>,
 }
@@ -94,6 +101,9 @@ pub enum PipelineError {
     /// The Delaunay tetrahedralization failed.
     #[error(transparent)]
     Delaunay(#[from] DelaunayError),
+    /// Boundary recovery could not run.
+    #[error(transparent)]
+    Recover(#[from] RecoverError),
     /// Smoothing failed.
     #[error(transparent)]
     Smooth(#[from] SmoothError),
@@ -166,7 +176,10 @@ pub fn mesh_surface(
             let i = v.iter().find(|&&x| x >= ns).copied().unwrap_or(0);
             dep.interior_regions[(i - ns) as usize]
         };
-        if label != 0 {
+        // With recovery to follow, every tet is kept: recovery works on the convex hull and
+        // labels by flood fill across the recovered surface; the centroid labels stay only
+        // where it cannot (triangles left unrecovered).
+        if label != 0 || opts.recover.is_some() {
             kept[t as usize / 64] |= 1 << (t % 64);
             tets.push(v);
             labels.push(label);
@@ -197,10 +210,25 @@ pub fn mesh_surface(
         // Repeated input points share a vertex: give every input index its coordinates back.
         points = (0..n_points).map(|i| points[map[i] as usize]).collect();
     }
-    let mesh = compact(points, tets, neighbors, labels);
+    let mut mesh = compact(points, tets, neighbors, labels);
     stage(&mut report, "keep inside", clock);
 
-    let mut mesh = mesh;
+    if let Some(o) = &opts.recover {
+        progress("recovering the boundary");
+        let clock = Instant::now();
+        let r = recover(
+            &mut mesh,
+            surface,
+            &RecoverOptions {
+                remove_outside: false,
+                ..*o
+            },
+        )?;
+        report.recover = Some(r);
+        mesh = remove_outside(mesh);
+        stage(&mut report, "recover", clock);
+    }
+
     if let Some(o) = &opts.smooth {
         progress("smoothing");
         let clock = Instant::now();
@@ -268,6 +296,43 @@ fn compact(
         neighbors,
         labels,
     }
+}
+
+/// Drop the tets of region 0 and the points only they used.
+fn remove_outside(mesh: TetMesh) -> TetMesh {
+    let TetMesh {
+        points,
+        tets,
+        neighbors,
+        labels,
+    } = mesh;
+    let mut index = vec![NO_NEIGHBOR; tets.len()];
+    let mut n = 0u32;
+    for (t, &l) in labels.iter().enumerate() {
+        if l != 0 {
+            index[t] = n;
+            n += 1;
+        }
+    }
+    if n as usize == tets.len() {
+        return compact(points, tets, neighbors, labels);
+    }
+    let keep = |t: &usize| labels[*t] != 0;
+    let kept_tets: Vec<[u32; 4]> = (0..tets.len()).filter(keep).map(|t| tets[t]).collect();
+    let kept_nb: Vec<[u32; 4]> = (0..tets.len())
+        .filter(keep)
+        .map(|t| {
+            neighbors[t].map(|x| {
+                if x == NO_NEIGHBOR {
+                    x
+                } else {
+                    index[x as usize]
+                }
+            })
+        })
+        .collect();
+    let kept_labels: Vec<u32> = labels.iter().copied().filter(|&l| l != 0).collect();
+    compact(points, kept_tets, kept_nb, kept_labels)
 }
 
 /// Input triangles that are not a face of any tet (matched by point coordinates).

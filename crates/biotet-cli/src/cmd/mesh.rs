@@ -226,6 +226,9 @@ pub fn run(a: Args) -> Result<ExitCode> {
     if a.no_smooth {
         opts.smooth = None;
     }
+    if a.no_recover {
+        opts.recover = None;
+    }
     let (mesh, report) = mesh_surface(&surface, &sizing, &opts, &mut |s| stage.set(s))
         .with_context(|| name.clone())?;
 
