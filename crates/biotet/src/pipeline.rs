@@ -8,7 +8,9 @@ use rustc_hash::{FxHashMap, FxHashSet};
 use serde::Serialize;
 
 use crate::delaunay::{Delaunay, DelaunayError};
-use crate::lastresort::{RecoverError, RecoverOptions, RecoverReport, recover};
+use crate::lastresort::{
+    ImproveOptions, ImproveReport, RecoverError, RecoverOptions, RecoverReport, improve, recover,
+};
 use crate::mesh::inside::{Location, RegionLocator, Transitions};
 use crate::mesh::surface::SurfaceMesh;
 use crate::mesh::tet::{NO_NEIGHBOR, TetMesh};
@@ -23,6 +25,8 @@ pub struct PipelineOptions {
     pub deploy: DeployOptions,
     /// Boundary recovery (`None` skips it).
     pub recover: Option<RecoverOptions>,
+    /// Sliver removal (`None` skips it).
+    pub improve: Option<ImproveOptions>,
     /// Smoothing (`None` skips it). Surface nodes stay fixed by default, so the surface is kept
     /// exactly.
     pub smooth: Option<SmoothOptions>,
@@ -33,6 +37,7 @@ impl PipelineOptions {
     pub fn deploy_only() -> PipelineOptions {
         PipelineOptions {
             recover: None,
+            improve: None,
             smooth: None,
             ..PipelineOptions::default()
         }
@@ -44,6 +49,7 @@ impl Default for PipelineOptions {
         PipelineOptions {
             deploy: DeployOptions::default(),
             recover: Some(RecoverOptions::default()),
+            improve: Some(ImproveOptions::default()),
             // Clusters already above 0.1 sr are left alone: on brain_20k that halves the time and
             // changes the tets below 10° by 0.1%.
             smooth: Some(SmoothOptions {
@@ -88,6 +94,8 @@ pub struct MeshReport {
     pub missing_triangles: usize,
     /// What boundary recovery did (if it ran).
     pub recover: Option<RecoverReport>,
+    /// What sliver removal did (if it ran).
+    pub improve: Option<ImproveReport>,
     /// What smoothing did (if it ran).
     pub smooth: Option<SmoothReport>,
 }
@@ -229,6 +237,12 @@ pub fn mesh_surface(
         stage(&mut report, "recover", clock);
     }
 
+    if let Some(o) = &opts.improve {
+        progress("removing slivers");
+        let clock = Instant::now();
+        report.improve = Some(improve(&mut mesh, o));
+        stage(&mut report, "improve", clock);
+    }
     if let Some(o) = &opts.smooth {
         progress("smoothing");
         let clock = Instant::now();

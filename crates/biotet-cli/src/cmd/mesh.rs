@@ -229,6 +229,9 @@ pub fn run(a: Args) -> Result<ExitCode> {
     if a.no_recover {
         opts.recover = None;
     }
+    if a.no_improve {
+        opts.improve = None;
+    }
     let (mesh, report) = mesh_surface(&surface, &sizing, &opts, &mut |s| stage.set(s))
         .with_context(|| name.clone())?;
 
@@ -252,9 +255,11 @@ pub fn run(a: Args) -> Result<ExitCode> {
             "input": name,
             "output": a.output,
             "n_surface_triangles": surface.triangles.len(),
+            "shells": shells,
             "seconds_read_validate": seconds_read,
             "pipeline": report,
             "quality": quality,
+            "forcing": forcing,
             "rss_before_kb": rss_before_kb,
             "peak_rss_kb": peak_kb,
             "mesh_bytes": mesh.bytes(),

@@ -5,14 +5,17 @@
 //! - [`search`]: Algorithm 3.1, the search that fills a closed cavity shell with tets whose
 //!   corners are cavity points ([`fill`], [`Searcher`]).
 //! - [`recover`](mod@recover): Algorithm 3.2, the boundary recovery driver ([`recover()`]).
+//! - [`improve`](mod@improve): sliver removal with the same search (section 3.4, [`improve()`]).
 //!
 //! Every combinatorial decision is an exact predicate (orient3d, exact segment–triangle and
 //! triangle–triangle tests); floating point only ranks tets by quality.
 
 mod cells;
+pub mod improve;
 pub mod recover;
 pub mod search;
 
+pub use improve::{ImproveOptions, ImproveReport, Metric, MoveCounts, improve};
 pub use recover::{Domain, RecoverError, RecoverOptions, RecoverReport, Unrecovered, recover};
 
 pub use search::{Fill, SearchError, SearchOptions, Searcher, fill};

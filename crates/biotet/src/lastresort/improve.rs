@@ -1,0 +1,724 @@
+//! Sliver removal with LAST RESORT (dissertation sections 3.3.1 and 3.4): carve the cavity
+//! around a poor tet, keep its shell exactly, and refill it with the best tets the existing points
+//! allow; accept only if the cavity's worst tet improves.
+//!
+//! For each tet below the threshold, worst first, three moves are tried in order of cost, each a
+//! search ([`Searcher`]) on a closed cavity with branch and bound on the worst tet:
+//! 1. **face flips**: the tet and its neighbour across a face (the 2-3 flip, or any better fill
+//!    of the two-tet cavity);
+//! 2. **edge removal**: the ring of tets around one of its edges (3-2 flips and their
+//!    generalisation n-to-(2n−4), or any better fill of the ring);
+//! 3. **the seed's cavity**: every tet sharing a corner with it, grown once by the next ring if
+//!    that fails.
+//!
+//! Cavities never cross a region: only tets with the bad tet's label are carved, so boundary
+//! and interface faces are always on the shell and stay exactly as they are. Points are never
+//! added, moved or removed (the corners strictly inside a cavity are handed to the search as
+//! points that every fill must use).
+//!
+//! The search's quality threshold ηe is set to the cavity's current worst q, so it only
+//! explores fills that could be accepted; acceptance compares the chosen metric (q or the
+//! smallest dihedral angle) of the worst tet before and after.
+
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+use std::time::Instant;
+
+use rustc_hash::{FxHashMap, FxHashSet};
+use serde::Serialize;
+
+use super::search::{SearchOptions, Searcher};
+use crate::mesh::tet::{NO_NEIGHBOR, TET_FACES, TetMesh};
+use crate::quality::tet::{dihedral_angles, q_measure};
+
+type P3 = [f64; 3];
+
+/// Which measure selects and judges tets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Metric {
+    /// q of eq. 4.9 (1 for the regular tet).
+    Q,
+    /// The smallest dihedral angle, in degrees.
+    Dihedral,
+}
+
+/// Options of [`improve`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImproveOptions {
+    /// The measure.
+    pub metric: Metric,
+    /// Tets whose measure is below this are improved (q, or degrees).
+    pub threshold: f64,
+    /// Try face flips and edge removal before the seed's cavity.
+    pub local_moves: bool,
+    /// Grow a failing cavity once by the next ring of tets.
+    pub grow: bool,
+    /// Search nodes for a first fill of one cavity.
+    pub max_nodes: u64,
+    /// Extra search nodes spent looking for a better worst tet (branch and bound).
+    pub improve_nodes: u64,
+    /// Cavities with more tets than this are not searched.
+    pub max_cavity_tets: usize,
+    /// How many times a tet may re-enter the queue after its cavity was refilled.
+    pub max_rounds: u32,
+    /// A tet is forced poor by the input when one of its boundary or interface faces has an
+    /// angle below this (degrees), or the boundary folds to a wedge below it at one of its
+    /// edges; forced tets get the local moves only (no refill can remove a poor input triangle).
+    pub forced_deg: f64,
+}
+
+impl Default for ImproveOptions {
+    fn default() -> ImproveOptions {
+        ImproveOptions {
+            metric: Metric::Dihedral,
+            threshold: 10.0,
+            local_moves: true,
+            grow: true,
+            max_nodes: 2_000,
+            improve_nodes: 2_000,
+            max_cavity_tets: 400,
+            max_rounds: 4,
+            forced_deg: 10.0,
+        }
+    }
+}
+
+/// Counts of one kind of move.
+#[derive(Debug, Clone, Copy, Default, Serialize)]
+pub struct MoveCounts {
+    /// Searches run.
+    pub calls: usize,
+    /// Fills accepted.
+    pub accepted: usize,
+    /// Milliseconds spent in these searches.
+    pub ms: f64,
+    /// Searches that found no fill above the current worst tet (the tree was exhausted).
+    pub no_fill: usize,
+    /// Searches stopped by the node budget.
+    pub budget: usize,
+    /// Fills found but not better by the metric.
+    pub not_better: usize,
+}
+
+/// What [`improve`] did.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct ImproveReport {
+    /// Metric and threshold.
+    pub metric: Option<Metric>,
+    /// The threshold.
+    pub threshold: f64,
+    /// Tets below the threshold before.
+    pub n_bad_before: usize,
+    /// Tets below the threshold after.
+    pub n_bad_after: usize,
+    /// Tets before and after.
+    pub n_tets_before: usize,
+    /// Tets after.
+    pub n_tets_after: usize,
+    /// Face-flip cavities (two tets).
+    pub face_flips: MoveCounts,
+    /// Edge-removal cavities (the ring around an edge).
+    pub edge_removals: MoveCounts,
+    /// The seed's cavities (every tet sharing a corner with the bad tet).
+    pub star_cavities: MoveCounts,
+    /// The seed's cavities grown by a ring.
+    pub grown_cavities: MoveCounts,
+    /// Tets skipped by the seed's cavity because the input forces them poor.
+    pub forced_skipped: usize,
+    /// All searches.
+    pub calls: usize,
+    /// Median time of one search, milliseconds.
+    pub call_ms_median: f64,
+    /// Largest time of one search, milliseconds.
+    pub call_ms_max: f64,
+    /// Median search nodes per call.
+    pub nodes_median: u64,
+    /// Wall seconds.
+    pub seconds: f64,
+}
+
+/// The measure of a tet.
+#[inline]
+fn measure(c: &[P3; 4], m: Metric) -> f64 {
+    match m {
+        Metric::Q => q_measure(c),
+        Metric::Dihedral => dihedral_angles(c)
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min)
+            .to_degrees(),
+    }
+}
+
+/// Smallest angle (radians) of a triangle.
+fn min_angle(c: &[P3; 3]) -> f64 {
+    use crate::geom::vec3::{cross, dot, norm, sub};
+    (0..3)
+        .map(|i| {
+            let u = sub(c[(i + 1) % 3], c[i]);
+            let v = sub(c[(i + 2) % 3], c[i]);
+            norm(cross(u, v)).atan2(dot(u, v))
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// A tet in the queue, worst first.
+#[derive(Debug, Clone, Copy)]
+struct Entry {
+    value: f64,
+    tet: u32,
+}
+
+impl PartialEq for Entry {
+    fn eq(&self, o: &Self) -> bool {
+        self.cmp(o) == Ordering::Equal
+    }
+}
+impl Eq for Entry {}
+impl PartialOrd for Entry {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for Entry {
+    fn cmp(&self, o: &Self) -> Ordering {
+        // BinaryHeap is a max-heap: the smallest value (worst) must compare greatest; ties by
+        // lower tet id first, for determinism.
+        o.value
+            .total_cmp(&self.value)
+            .then_with(|| o.tet.cmp(&self.tet))
+    }
+}
+
+/// The mesh being edited: tets with tombstones, adjacency, one incident tet per point.
+struct Work<'a> {
+    pts: &'a [P3],
+    tets: Vec<[u32; 4]>,
+    nb: Vec<[u32; 4]>,
+    labels: Vec<u32>,
+    alive: Vec<bool>,
+    rounds: Vec<u32>,
+    /// Per tet: 0 unknown, 1 forced, 2 not forced.
+    forced: Vec<u8>,
+    vtet: Vec<u32>,
+    free: Vec<u32>,
+    searcher: Searcher,
+    opts: ImproveOptions,
+    report: ImproveReport,
+    call_ms: Vec<f64>,
+    call_nodes: Vec<u64>,
+    queue: BinaryHeap<Entry>,
+    // Scratch.
+    mark: FxHashSet<u32>,
+}
+
+/// One carved cavity: its tets, the shell (faces pointing into it) with the tet outside each
+/// shell face and that tet's local face, and the corners strictly inside.
+struct Cavity {
+    tets: Vec<u32>,
+    shell: Vec<[u32; 3]>,
+    outer: Vec<(u32, u8)>,
+    inner: Vec<u32>,
+}
+
+impl<'a> Work<'a> {
+    fn corners(&self, t: u32) -> [P3; 4] {
+        self.tets[t as usize].map(|v| self.pts[v as usize])
+    }
+
+    fn value(&self, t: u32) -> f64 {
+        measure(&self.corners(t), self.opts.metric)
+    }
+
+    /// Every live tet with corner `v` (walking across the faces around `v`).
+    fn star(&mut self, v: u32, out: &mut Vec<u32>) {
+        let start = self.vtet[v as usize];
+        if start == NO_NEIGHBOR {
+            return;
+        }
+        let mut stack = vec![start];
+        let mut seen: FxHashSet<u32> = Default::default();
+        seen.insert(start);
+        while let Some(t) = stack.pop() {
+            out.push(t);
+            let tv = self.tets[t as usize];
+            for (i, &n) in self.nb[t as usize].iter().enumerate() {
+                // Faces containing v are those opposite the other corners.
+                if tv[i] != v && n != NO_NEIGHBOR && seen.insert(n) {
+                    stack.push(n);
+                }
+            }
+        }
+    }
+
+    /// Build the cavity of `tets` (all of one label): shell faces turned inward, the tets across
+    /// them, and the inner corners.
+    fn cavity(&mut self, tets: Vec<u32>) -> Cavity {
+        self.mark.clear();
+        self.mark.extend(tets.iter().copied());
+        let mut shell = Vec::new();
+        let mut outer = Vec::new();
+        let mut on_shell: FxHashSet<u32> = Default::default();
+        let mut all: Vec<u32> = Vec::new();
+        for &t in &tets {
+            let v = self.tets[t as usize];
+            all.extend_from_slice(&v);
+            for (i, l) in TET_FACES.iter().enumerate() {
+                let n = self.nb[t as usize][i];
+                if n != NO_NEIGHBOR && self.mark.contains(&n) {
+                    continue;
+                }
+                // Outward face reversed: the normal points into the cavity.
+                let f = [v[l[0]], v[l[2]], v[l[1]]];
+                on_shell.extend(f);
+                shell.push(f);
+                let j = if n == NO_NEIGHBOR {
+                    0
+                } else {
+                    self.nb[n as usize]
+                        .iter()
+                        .position(|&x| x == t)
+                        .unwrap_or(0) as u8
+                };
+                outer.push((n, j));
+            }
+        }
+        all.sort_unstable();
+        all.dedup();
+        let inner = all.into_iter().filter(|v| !on_shell.contains(v)).collect();
+        Cavity {
+            tets,
+            shell,
+            outer,
+            inner,
+        }
+    }
+
+    /// Refill `cav` if a fill with a better worst tet exists; true when accepted.
+    fn try_cavity(
+        &mut self,
+        cav: &Cavity,
+        counts: fn(&mut ImproveReport) -> &mut MoveCounts,
+    ) -> bool {
+        if cav.tets.len() > self.opts.max_cavity_tets {
+            return false;
+        }
+        let old_worst = cav
+            .tets
+            .iter()
+            .map(|&t| self.value(t))
+            .fold(f64::INFINITY, f64::min);
+        let old_q = cav
+            .tets
+            .iter()
+            .map(|&t| q_measure(&self.corners(t)))
+            .fold(f64::INFINITY, f64::min);
+        let so = SearchOptions {
+            min_quality: old_q.max(0.0),
+            max_nodes: self.opts.max_nodes,
+            improve: Some(self.opts.improve_nodes),
+        };
+        let clock = Instant::now();
+        let result = self.searcher.fill(self.pts, &cav.shell, &cav.inner, &so);
+        let ms = clock.elapsed().as_secs_f64() * 1e3;
+        self.call_ms.push(ms);
+        counts(&mut self.report).calls += 1;
+        counts(&mut self.report).ms += ms;
+        let fill = match result {
+            Ok(f) => f,
+            Err(e) => {
+                self.call_nodes.push(0);
+                match e {
+                    super::search::SearchError::Budget { .. } => {
+                        counts(&mut self.report).budget += 1
+                    }
+                    _ => counts(&mut self.report).no_fill += 1,
+                }
+                return false;
+            }
+        };
+        self.call_nodes.push(fill.nodes_visited);
+        let new_worst = fill
+            .tets
+            .iter()
+            .map(|t| measure(&t.map(|v| self.pts[v as usize]), self.opts.metric))
+            .fold(f64::INFINITY, f64::min);
+        if new_worst <= old_worst {
+            counts(&mut self.report).not_better += 1;
+            return false;
+        }
+        counts(&mut self.report).accepted += 1;
+        self.replace(cav, &fill.tets);
+        true
+    }
+
+    /// Swap the cavity's tets for `new` and stitch the adjacency.
+    fn replace(&mut self, cav: &Cavity, new: &[[u32; 4]]) {
+        let label = self.labels[cav.tets[0] as usize];
+        let rounds = cav
+            .tets
+            .iter()
+            .map(|&t| self.rounds[t as usize])
+            .max()
+            .unwrap_or(0)
+            + 1;
+        for &t in &cav.tets {
+            self.alive[t as usize] = false;
+            self.free.push(t);
+        }
+        // Shell faces by vertex set -> the tet outside and its local face.
+        let mut outside: FxHashMap<[u32; 3], (u32, u8)> = Default::default();
+        for (f, &o) in cav.shell.iter().zip(&cav.outer) {
+            let mut k = *f;
+            k.sort_unstable();
+            outside.insert(k, o);
+        }
+        let mut inner_faces: FxHashMap<[u32; 3], (u32, u8)> = Default::default();
+        let mut ids = Vec::with_capacity(new.len());
+        for tv in new {
+            let t = match self.free.pop() {
+                Some(t) => {
+                    self.forced[t as usize] = 0;
+                    self.tets[t as usize] = *tv;
+                    self.nb[t as usize] = [NO_NEIGHBOR; 4];
+                    self.labels[t as usize] = label;
+                    self.alive[t as usize] = true;
+                    self.rounds[t as usize] = rounds;
+                    t
+                }
+                None => {
+                    self.tets.push(*tv);
+                    self.nb.push([NO_NEIGHBOR; 4]);
+                    self.labels.push(label);
+                    self.alive.push(true);
+                    self.rounds.push(rounds);
+                    self.forced.push(0);
+                    (self.tets.len() - 1) as u32
+                }
+            };
+            ids.push(t);
+            for &v in tv {
+                self.vtet[v as usize] = t;
+            }
+        }
+        for &t in &ids {
+            let tv = self.tets[t as usize];
+            for (i, l) in TET_FACES.iter().enumerate() {
+                let mut k = [tv[l[0]], tv[l[1]], tv[l[2]]];
+                k.sort_unstable();
+                if let Some(&(n, j)) = outside.get(&k) {
+                    self.nb[t as usize][i] = n;
+                    if n != NO_NEIGHBOR {
+                        self.nb[n as usize][j as usize] = t;
+                    }
+                } else if let Some((u, j)) = inner_faces.remove(&k) {
+                    self.nb[t as usize][i] = u;
+                    self.nb[u as usize][j as usize] = t;
+                } else {
+                    inner_faces.insert(k, (t, i as u8));
+                }
+            }
+        }
+        debug_assert!(inner_faces.is_empty());
+        for &t in &ids {
+            let v = self.value(t);
+            if v < self.opts.threshold && self.rounds[t as usize] <= self.opts.max_rounds {
+                self.queue_push(v, t);
+            }
+        }
+    }
+
+    /// The tets around edge `ab` of `tet`, if they all carry `label` and close a ring (the edge
+    /// is not on a boundary or interface).
+    fn ring(&self, tet: u32, a: u32, b: u32, label: u32) -> Option<Vec<u32>> {
+        let mut ring = vec![tet];
+        let mut prev = NO_NEIGHBOR;
+        let mut t = tet;
+        loop {
+            let tv = self.tets[t as usize];
+            // The two faces holding edge ab are opposite the two other corners; step across the
+            // one that does not lead back.
+            let mut next = NO_NEIGHBOR;
+            for i in 0..4 {
+                if tv[i] == a || tv[i] == b {
+                    continue;
+                }
+                let n = self.nb[t as usize][i];
+                if n == NO_NEIGHBOR || self.labels[n as usize] != label {
+                    return None;
+                }
+                if n != prev {
+                    next = n;
+                }
+            }
+            if next == tet {
+                return (ring.len() >= 3).then_some(ring);
+            }
+            if next == NO_NEIGHBOR || ring.len() > 16 {
+                return None;
+            }
+            prev = t;
+            t = next;
+            ring.push(t);
+        }
+    }
+
+    /// Whether the input forces `tet` to be poor (see [`ImproveOptions::forced_deg`]).
+    fn is_forced(&mut self, tet: u32) -> bool {
+        match self.forced[tet as usize] {
+            1 => return true,
+            2 => return false,
+            _ => {}
+        }
+        let f = self.compute_forced(tet);
+        self.forced[tet as usize] = if f { 1 } else { 2 };
+        f
+    }
+
+    fn compute_forced(&self, tet: u32) -> bool {
+        let tv = self.tets[tet as usize];
+        let label = self.labels[tet as usize];
+        let lim = self.opts.forced_deg.to_radians();
+        let fixed = |n: u32| n == NO_NEIGHBOR || self.labels[n as usize] != label;
+        for (i, l) in TET_FACES.iter().enumerate() {
+            if fixed(self.nb[tet as usize][i]) {
+                let c = l.map(|k| self.pts[tv[k] as usize]);
+                if min_angle(&c) < lim {
+                    return true;
+                }
+            }
+        }
+        // A boundary edge: the wedge of this region around it, summed over its tets.
+        for e in crate::mesh::tet::TET_EDGES {
+            let (a, b) = (tv[e[0]], tv[e[1]]);
+            if let Some(w) = self.wedge(tet, a, b, label)
+                && w < lim
+            {
+                return true;
+            }
+        }
+        false
+    }
+
+    /// The region's dihedral wedge at edge `ab` of `tet` when the edge is on the region's
+    /// boundary (the sum of the angles at `ab` of the region's tets around it); `None` for an
+    /// interior edge.
+    fn wedge(&self, tet: u32, a: u32, b: u32, label: u32) -> Option<f64> {
+        let angle_at = |t: u32| {
+            let tv = self.tets[t as usize];
+            let ia = tv.iter().position(|&v| v == a).unwrap_or(0);
+            let ib = tv.iter().position(|&v| v == b).unwrap_or(0);
+            let e = crate::mesh::tet::TET_EDGES
+                .iter()
+                .position(|&[x, y]| (x == ia && y == ib) || (x == ib && y == ia))
+                .unwrap_or(0);
+            dihedral_angles(&self.corners(t))[e]
+        };
+        let mut sum = angle_at(tet);
+        let tv = self.tets[tet as usize];
+        let mut open = false;
+        for i in 0..4 {
+            if tv[i] == a || tv[i] == b {
+                continue;
+            }
+            // Walk away from tet across face i around the edge until the region ends.
+            let (mut prev, mut t) = (tet, self.nb[tet as usize][i]);
+            let mut steps = 0;
+            loop {
+                if t == NO_NEIGHBOR || self.labels[t as usize] != label {
+                    open = true;
+                    break;
+                }
+                if t == tet || steps > 64 {
+                    return None; // closed ring: an interior edge
+                }
+                sum += angle_at(t);
+                let v = self.tets[t as usize];
+                let next = (0..4)
+                    .filter(|&k| v[k] != a && v[k] != b)
+                    .map(|k| self.nb[t as usize][k])
+                    .find(|&n| n != prev)
+                    .unwrap_or(NO_NEIGHBOR);
+                prev = t;
+                t = next;
+                steps += 1;
+            }
+        }
+        open.then_some(sum)
+    }
+
+    fn queue_push(&mut self, value: f64, tet: u32) {
+        self.queue.push(Entry { value, tet });
+    }
+}
+
+/// Improve the tets of `mesh` below the threshold (see the module docs). Points, boundary and
+/// interface faces are untouched; tets keep their labels; tet order is not kept.
+pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
+    let clock = Instant::now();
+    let mut w = Work {
+        pts: &mesh.points,
+        tets: std::mem::take(&mut mesh.tets),
+        nb: std::mem::take(&mut mesh.neighbors),
+        labels: std::mem::take(&mut mesh.labels),
+        alive: Vec::new(),
+        rounds: Vec::new(),
+        forced: Vec::new(),
+        vtet: vec![NO_NEIGHBOR; mesh.points.len()],
+        free: Vec::new(),
+        searcher: Searcher::new(),
+        opts: *opts,
+        report: ImproveReport {
+            metric: Some(opts.metric),
+            threshold: opts.threshold,
+            ..ImproveReport::default()
+        },
+        call_ms: Vec::new(),
+        call_nodes: Vec::new(),
+        mark: Default::default(),
+        queue: BinaryHeap::new(),
+    };
+    let n = w.tets.len();
+    w.alive = vec![true; n];
+    w.rounds = vec![0; n];
+    w.forced = vec![0; n];
+    w.report.n_tets_before = n;
+    for t in 0..n {
+        for &v in &w.tets[t] {
+            w.vtet[v as usize] = t as u32;
+        }
+    }
+    for t in 0..n as u32 {
+        let v = w.value(t);
+        if v < opts.threshold {
+            w.report.n_bad_before += 1;
+            w.queue_push(v, t);
+        }
+    }
+    let mut scratch = Vec::new();
+    while let Some(Entry { tet, value }) = w.queue.pop() {
+        if !w.alive[tet as usize] || w.value(tet) != value {
+            continue;
+        }
+        let label = w.labels[tet as usize];
+        let mut done = false;
+        if opts.local_moves {
+            // Face flips.
+            for i in 0..4 {
+                let n = w.nb[tet as usize][i];
+                if n == NO_NEIGHBOR || w.labels[n as usize] != label || w.is_forced(n) {
+                    continue;
+                }
+                let cav = w.cavity(vec![tet, n]);
+                if w.try_cavity(&cav, |r| &mut r.face_flips) {
+                    done = true;
+                    break;
+                }
+            }
+            // Edge removal.
+            if !done {
+                let tv = w.tets[tet as usize];
+                for e in crate::mesh::tet::TET_EDGES {
+                    let (a, b) = (tv[e[0]], tv[e[1]]);
+                    let Some(ring) = w.ring(tet, a, b, label) else {
+                        continue;
+                    };
+                    let cav = w.cavity(ring);
+                    if w.try_cavity(&cav, |r| &mut r.edge_removals) {
+                        done = true;
+                        break;
+                    }
+                }
+            }
+        }
+        if !done && w.is_forced(tet) {
+            w.report.forced_skipped += 1;
+            done = true;
+        }
+        if !done {
+            // The seed's cavity: every tet of this label sharing a corner.
+            scratch.clear();
+            let tv = w.tets[tet as usize];
+            for v in tv {
+                w.star(v, &mut scratch);
+            }
+            // Forced tets stay: their poor input face would pin the cavity's worst tet, so no
+            // refill could be accepted; leaving them out puts their faces on the shell.
+            let mut tets: Vec<u32> = Vec::new();
+            for &t in &scratch {
+                if w.labels[t as usize] == label && (t == tet || !w.is_forced(t)) {
+                    tets.push(t);
+                }
+            }
+            tets.sort_unstable();
+            tets.dedup();
+            let cav = w.cavity(tets.clone());
+            done = w.try_cavity(&cav, |r| &mut r.star_cavities);
+            if !done && opts.grow {
+                let mut grown = tets.clone();
+                for &t in &tets {
+                    for i in 0..4 {
+                        let n = w.nb[t as usize][i];
+                        if n != NO_NEIGHBOR && w.labels[n as usize] == label && !w.is_forced(n) {
+                            grown.push(n);
+                        }
+                    }
+                }
+                grown.sort_unstable();
+                grown.dedup();
+                if grown.len() > tets.len() {
+                    let cav = w.cavity(grown);
+                    w.try_cavity(&cav, |r| &mut r.grown_cavities);
+                }
+            }
+        }
+    }
+    // Compact.
+    let mut index = vec![NO_NEIGHBOR; w.tets.len()];
+    let mut k = 0u32;
+    for t in 0..w.tets.len() {
+        if w.alive[t] {
+            index[t] = k;
+            k += 1;
+        }
+    }
+    let mut tets = Vec::with_capacity(k as usize);
+    let mut nb = Vec::with_capacity(k as usize);
+    let mut labels = Vec::with_capacity(k as usize);
+    for t in 0..w.tets.len() {
+        if w.alive[t] {
+            tets.push(w.tets[t]);
+            nb.push(w.nb[t].map(|n| {
+                if n == NO_NEIGHBOR {
+                    n
+                } else {
+                    index[n as usize]
+                }
+            }));
+            labels.push(w.labels[t]);
+        }
+    }
+    let pts = &mesh.points;
+    let bad_after = tets
+        .iter()
+        .filter(|t| measure(&t.map(|v| pts[v as usize]), opts.metric) < opts.threshold)
+        .count();
+    let mut report = std::mem::take(&mut w.report);
+    report.n_bad_after = bad_after;
+    report.n_tets_after = tets.len();
+    let mut ms = std::mem::take(&mut w.call_ms);
+    ms.sort_by(f64::total_cmp);
+    let mut nodes = std::mem::take(&mut w.call_nodes);
+    nodes.sort_unstable();
+    report.calls = ms.len();
+    report.call_ms_median = ms.get(ms.len() / 2).copied().unwrap_or(0.0);
+    report.call_ms_max = ms.last().copied().unwrap_or(0.0);
+    report.nodes_median = nodes.get(nodes.len() / 2).copied().unwrap_or(0);
+    drop(w);
+    mesh.tets = tets;
+    mesh.neighbors = nb;
+    mesh.labels = labels;
+    report.seconds = clock.elapsed().as_secs_f64();
+    report
+}
