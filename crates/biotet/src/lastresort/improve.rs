@@ -440,8 +440,8 @@ impl<'a> Work<'a> {
             // The two faces holding edge ab are opposite the two other corners; step across the
             // one that does not lead back.
             let mut next = NO_NEIGHBOR;
-            for i in 0..4 {
-                if tv[i] == a || tv[i] == b {
+            for (i, &x) in tv.iter().enumerate() {
+                if x == a || x == b {
                     continue;
                 }
                 let n = self.nb[t as usize][i];
@@ -518,8 +518,8 @@ impl<'a> Work<'a> {
         let mut sum = angle_at(tet);
         let tv = self.tets[tet as usize];
         let mut open = false;
-        for i in 0..4 {
-            if tv[i] == a || tv[i] == b {
+        for (i, &x) in tv.iter().enumerate() {
+            if x == a || x == b {
                 continue;
             }
             // Walk away from tet across face i around the edge until the region ends.
@@ -677,9 +677,9 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     // Compact.
     let mut index = vec![NO_NEIGHBOR; w.tets.len()];
     let mut k = 0u32;
-    for t in 0..w.tets.len() {
+    for (t, slot) in index.iter_mut().enumerate() {
         if w.alive[t] {
-            index[t] = k;
+            *slot = k;
             k += 1;
         }
     }
