@@ -48,6 +48,11 @@ enum Command {
     Mesh(cmd::mesh::Args),
     /// Raise the smallest solid angles of a tet mesh by moving nodes (surface fixed or sliding).
     Smooth(cmd::smooth::Args),
+    /// Make every triangle of a surface a face of a tet mesh (LAST RESORT), without new points
+    /// on the surface.
+    Recover(cmd::recover::Args),
+    /// Remove slivers by refilling their cavities (LAST RESORT); points and surface untouched.
+    Improve(cmd::improve::Args),
     /// Validate closed surfaces: closed, manifold, consistently oriented, no self-intersection.
     Validate(cmd::validate::Args),
 }
@@ -68,6 +73,8 @@ fn main() -> ExitCode {
         Command::Validate(a) => cmd::validate::run(a),
         Command::Delaunay(a) => cmd::delaunay::run(a),
         Command::Mesh(a) => cmd::mesh::run(a),
+        Command::Recover(a) => cmd::recover::run(a),
+        Command::Improve(a) => cmd::improve::run(a),
         Command::Smooth(a) => cmd::smooth::run(a),
     };
     match result {

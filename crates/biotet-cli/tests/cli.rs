@@ -695,3 +695,75 @@ fn smooth_errors_name_the_file_and_write_nothing() {
     let text = String::from_utf8_lossy(&help.stdout);
     assert!(help.status.success() && text.contains("--boundary") && text.contains("--json"));
 }
+
+#[test]
+fn recover_then_improve_a_mesh_made_without_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let brain = brain_surface();
+    let raw = dir.path().join("raw.vtu");
+    let out = biotet(&[
+        "mesh",
+        s(&brain),
+        "-o",
+        s(&raw),
+        "--no-recover",
+        "--no-improve",
+        "--no-smooth",
+        "--quiet",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    // Without recovery some triangles are missing: the checker says so.
+    let c = biotet(&["check", s(&raw), "--surface", s(&brain), "--quiet"]);
+    assert_eq!(c.status.code(), Some(1));
+    let rec = dir.path().join("rec.vtu");
+    let j = json_of(&biotet(&[
+        "recover",
+        s(&raw),
+        "-s",
+        s(&brain),
+        "-o",
+        s(&rec),
+        "--json",
+    ]));
+    assert_eq!(j["complete"], true, "{j}");
+    assert!(j["recover"]["missing_before"].as_u64().unwrap() > 100);
+    assert_eq!(j["recover"]["missing_after"], 0);
+    assert_eq!(j["recover"]["points_added"], 0);
+    let c = biotet(&["check", s(&rec), "--surface", s(&brain), "--json"]);
+    let cj: Value = serde_json::from_slice(&c.stdout).unwrap();
+    assert_eq!(cj["valid"], true, "{cj}");
+    let v = |path: &Path| {
+        json_of(&biotet(&["quality", s(path), "--json"]))["volume"]
+            .as_f64()
+            .unwrap()
+    };
+    assert!((v(&rec) - 1_659_213.0).abs() < 1.0, "{}", v(&rec));
+    // Sliver removal: fewer tets under 10°, the surface and the volume unchanged.
+    let imp = dir.path().join("imp.vtu");
+    let j = json_of(&biotet(&[
+        "improve",
+        s(&rec),
+        "-s",
+        s(&brain),
+        "-o",
+        s(&imp),
+        "--json",
+    ]));
+    let (b, a) = (&j["slivers_before"]["lt_10"], &j["slivers_after"]["lt_10"]);
+    assert!(a.as_u64().unwrap() * 2 < b.as_u64().unwrap(), "{b} → {a}");
+    assert!(
+        j["n_unforced_dihedral_lt_10"].as_u64().unwrap()
+            < j["forcing_before"]["n_unforced_dihedral_lt_10"]
+                .as_u64()
+                .unwrap()
+    );
+    let c = biotet(&["check", s(&imp), "--surface", s(&brain), "--json"]);
+    let cj: Value = serde_json::from_slice(&c.stdout).unwrap();
+    assert_eq!(cj["valid"], true, "{cj}");
+    assert!((v(&imp) - v(&rec)).abs() < 1e-6 * v(&rec));
+    let q = json_of(&biotet(&["quality", s(&imp), "--json"]));
+    assert_eq!(
+        q["n_points"],
+        json_of(&biotet(&["quality", s(&rec), "--json"]))["n_points"]
+    );
+}

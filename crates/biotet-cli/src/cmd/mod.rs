@@ -3,8 +3,10 @@
 pub mod check;
 pub mod convert;
 pub mod delaunay;
+pub mod improve;
 pub mod input;
 pub mod mesh;
 pub mod quality;
+pub mod recover;
 pub mod smooth;
 pub mod validate;
