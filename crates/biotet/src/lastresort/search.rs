@@ -220,6 +220,8 @@ pub struct Searcher {
     kill_log: Vec<(u32, u32, u8)>,
     /// The alive faces, in no particular order (dead ones are most of `faces` deep down).
     front: Vec<u32>,
+    /// The bounding boxes of the faces of `front`, in its order (scanned contiguously).
+    front_box: Vec<(P3, P3)>,
     /// Position of each face in `front` (kept after its death, for the undo).
     front_pos: Vec<u32>,
     removed_log: Vec<u32>,
@@ -495,6 +497,7 @@ impl Searcher {
         self.kill_log.clear();
         self.removed_log.clear();
         self.front.clear();
+        self.front_box.clear();
         self.front_pos.clear();
         let scratch = std::mem::take(&mut self.scratch);
         for &f in &scratch {
@@ -518,6 +521,7 @@ impl Searcher {
         let (lo, hi) = bbox3(&v.map(|x| self.pts[x as usize]));
         self.front_pos.push(self.front.len() as u32);
         self.front.push(id);
+        self.front_box.push((lo, hi));
         self.faces.push(Face {
             v,
             alive: true,
@@ -559,10 +563,13 @@ impl Searcher {
         }
         self.removed_log.push(f);
         let i = self.front_pos[f as usize] as usize;
+        let last_box = self.front_box.pop();
         if let Some(last) = self.front.pop()
             && last != f
+            && let Some(b) = last_box
         {
             self.front[i] = last;
+            self.front_box[i] = b;
             self.front_pos[last as usize] = i as u32;
         }
     }
@@ -576,15 +583,19 @@ impl Searcher {
         for &x in &v {
             self.front_deg[x as usize] += 1;
         }
+        let b = (face.lo, face.hi);
         let i = self.front_pos[f as usize] as usize;
         let n = self.front.len();
         if i < n {
             let moved = self.front[i];
             self.front_pos[moved as usize] = n as u32;
             self.front.push(moved);
+            self.front_box.push(self.front_box[i]);
             self.front[i] = f;
+            self.front_box[i] = b;
         } else {
             self.front.push(f);
+            self.front_box.push(b);
         }
     }
 
@@ -924,11 +935,11 @@ impl Searcher {
         lo: P3,
         hi: P3,
     ) -> bool {
-        for &g in self.front.iter().rev() {
-            if g == base {
+        for (&g, &(glo, ghi)) in self.front.iter().zip(&self.front_box).rev() {
+            if g == base || boxes_apart(lo, hi, glo, ghi) {
                 continue;
             }
-            if self.face_conflicts(t, tf, planes, g, lo, hi) {
+            if self.face_conflicts(t, tf, planes, g) {
                 return true;
             }
         }
@@ -944,15 +955,10 @@ impl Searcher {
         tf: &[[u32; 3]; 4],
         planes: &[Plane; 4],
         gid: u32,
-        lo: P3,
-        hi: P3,
     ) -> bool {
-        let face = &self.faces[gid as usize];
-        let g = face.v;
-        if boxes_apart(lo, hi, face.lo, face.hi) {
-            return false;
-        }
-        if tf.iter().any(|f| same_set(*f, g)) {
+        let g = self.faces[gid as usize].v;
+        // All three corners in the tet: g is one of its faces.
+        if g.iter().all(|x| t.contains(x)) {
             return false;
         }
         // g's plane (cached) with the tet on one closed side, touching only at corners of g.
@@ -1092,6 +1098,7 @@ impl Searcher {
                     self.front_deg[x as usize] -= 1;
                 }
                 self.front.pop();
+                self.front_box.pop();
                 self.front_pos.pop();
             }
         }
