@@ -17,9 +17,14 @@
 //! Given 3 for both tets, 4 is exactly "the tet lies in the closure of the unfilled region and
 //! meets its boundary only in shared vertices, edges and faces": if an active face met the open
 //! tet, its corners being outside it, some pair of faces would meet improperly. The unfilled
-//! region only shrinks, so a candidate once invalid stays invalid down the tree: candidates are
-//! computed once per face and only *filtered* when a tet is added (the same pairwise test against
-//! the new tet), and filtering is undone on backtracking.
+//! region only shrinks, so a candidate once invalid stays invalid down the tree: a checked
+//! candidate is only *filtered* when a tet is added (the same pairwise test against the new
+//! tet), and filtering is undone on backtracking.
+//!
+//! Conditions 1–2 are tested when a face joins the front; 3–4 lazily, against the current front:
+//! a face's candidates are checked only while its count could still be the smallest (module
+//! docs of `Searcher::dfs`), which leaves the search tree exactly as with eager checking.
+//! Orientations are cached per triangle for the whole call (the points never move).
 //!
 //! # How
 //! Every fill has exactly one tet on each active face, so branching over the candidates of one
@@ -164,8 +169,15 @@ struct Face {
     /// Candidate range in `Searcher::cands`.
     c0: u32,
     c1: u32,
-    /// Live candidates.
+    /// Candidates not known invalid (an upper bound on the count).
     live: u32,
+    /// Candidates checked valid.
+    valid: u32,
+    /// Its plane, oriented like `v`.
+    plane: Plane,
+    /// Its bounding box.
+    lo: P3,
+    hi: P3,
 }
 
 /// A candidate tet `face + p`.
@@ -173,7 +185,8 @@ struct Face {
 struct Cand {
     p: u32,
     q: f64,
-    dead: bool,
+    /// [`UNCHECKED`], [`VALID`] or [`DEAD`].
+    state: u8,
     lo: P3,
     hi: P3,
 }
@@ -203,7 +216,14 @@ pub struct Searcher {
     faces: Vec<Face>,
     cands: Vec<Cand>,
     map: FxHashMap<[u32; 3], u32>,
-    kill_log: Vec<u32>,
+    /// Candidate state changes (candidate, its face, previous state), undone on backtracking.
+    kill_log: Vec<(u32, u32, u8)>,
+    /// The alive faces, in no particular order (dead ones are most of `faces` deep down).
+    front: Vec<u32>,
+    /// The bounding boxes of the faces of `front`, in its order (scanned contiguously).
+    front_box: Vec<(P3, P3)>,
+    /// Position of each face in `front` (kept after its death, for the undo).
+    front_pos: Vec<u32>,
     removed_log: Vec<u32>,
     front_deg: Vec<u32>,
     uses: Vec<u32>,
@@ -219,27 +239,66 @@ pub struct Searcher {
     improve: Option<u64>,
     scratch: Vec<[u32; 3]>,
     edges: Vec<(u32, u32)>,
-    /// Cached orientations of every point against every face's plane, face-major
+    /// Rows of `orient`: one per triangle met (sorted corners), for the whole call: the points
+    /// never move, so an orientation once computed holds for every face, candidate and level.
+    rows: FxHashMap<[u32; 3], u32>,
+    /// Cached orientations of every point against each row's sorted triangle, row-major
     /// ([`UNKNOWN`] until computed).
-    sides: Vec<Cell<i8>>,
-    /// Orientations against the three new faces of the current candidate, stamped.
-    raw: Vec<Cell<(u32, i8)>>,
-    raw_stamp: Cell<u32>,
+    orient: Vec<Cell<i8>>,
+    /// The sorted triangle of each row.
+    row_keys: Vec<[u32; 3]>,
     /// Per edge of the face whose candidates are computed: the apex of the one other front face
     /// across it, and that face, when the region's wedge there is convex.
     wedge: [Option<u32>; 3],
 }
 
-/// Marks a not yet computed entry of `Searcher::sides`.
+/// Marks a not yet computed entry of `Searcher::orient`.
 const UNKNOWN: i8 = 2;
 
-/// A face plane of a tet, oriented outwards: a front face's (cached, possibly flipped) or a
-/// plain triangle's.
+/// Candidate states: conditions 1–2 hold, 3–4 not yet checked against the current front.
+const UNCHECKED: u8 = 0;
+/// All four conditions hold (checked, then filtered against every tet added since).
+const VALID: u8 = 1;
+/// Not a candidate (any more).
+const DEAD: u8 = 2;
+
+/// The plane of an oriented triangle: its row of cached orientations, and whether the triangle
+/// is an even permutation of the row's sorted corners (else every sign flips).
 #[derive(Debug, Clone, Copy)]
-enum Plane {
-    Face(u32, bool),
-    /// A plain triangle, its orientations cached in slot `k` (0..3) of the current candidate.
-    Tri(usize, [u32; 3]),
+struct Plane {
+    row: u32,
+    even: bool,
+}
+
+impl Plane {
+    /// The same plane, opposite orientation.
+    #[inline]
+    fn flip(self) -> Plane {
+        Plane {
+            row: self.row,
+            even: !self.even,
+        }
+    }
+}
+
+/// Sorted corners and whether `f` is an even permutation of them.
+#[inline]
+fn sort3(f: [u32; 3]) -> ([u32; 3], bool) {
+    let [mut a, mut b, mut c] = f;
+    let mut even = true;
+    if a > b {
+        std::mem::swap(&mut a, &mut b);
+        even = !even;
+    }
+    if b > c {
+        std::mem::swap(&mut b, &mut c);
+        even = !even;
+    }
+    if a > b {
+        std::mem::swap(&mut a, &mut b);
+        even = !even;
+    }
+    ([a, b, c], even)
 }
 
 /// Canonical rotation of an oriented triangle (smallest index first).
@@ -261,6 +320,19 @@ fn same_set(a: [u32; 3], b: [u32; 3]) -> bool {
 
 #[inline]
 fn bbox4(c: &[P3; 4]) -> (P3, P3) {
+    let mut lo = c[0];
+    let mut hi = c[0];
+    for p in &c[1..] {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    (lo, hi)
+}
+
+#[inline]
+fn bbox3(c: &[P3; 3]) -> (P3, P3) {
     let mut lo = c[0];
     let mut hi = c[0];
     for p in &c[1..] {
@@ -416,14 +488,17 @@ impl Searcher {
         self.front_deg.resize(np, 0);
         self.uses.clear();
         self.uses.resize(np, 0);
-        self.raw.clear();
-        self.raw.resize(3 * np, Cell::new((0, 0)));
-        self.raw_stamp.set(1);
+        self.rows.clear();
+        self.orient.clear();
+        self.row_keys.clear();
         self.faces.clear();
         self.cands.clear();
         self.map.clear();
         self.kill_log.clear();
         self.removed_log.clear();
+        self.front.clear();
+        self.front_box.clear();
+        self.front_pos.clear();
         let scratch = std::mem::take(&mut self.scratch);
         for &f in &scratch {
             if self.map.contains_key(&canon(f)) {
@@ -442,25 +517,40 @@ impl Searcher {
     fn push_face(&mut self, v: [u32; 3]) {
         let id = self.faces.len() as u32;
         let c = self.cands.len() as u32;
+        let plane = self.plane(v);
+        let (lo, hi) = bbox3(&v.map(|x| self.pts[x as usize]));
+        self.front_pos.push(self.front.len() as u32);
+        self.front.push(id);
+        self.front_box.push((lo, hi));
         self.faces.push(Face {
             v,
             alive: true,
             c0: c,
             c1: c,
             live: 0,
+            valid: 0,
+            plane,
+            lo,
+            hi,
         });
         self.map.insert(canon(v), id);
         for &x in &v {
             self.front_deg[x as usize] += 1;
         }
-        let np = self.pts.len();
-        let row = id as usize * np;
-        if self.sides.len() < row + np {
-            self.sides.resize_with(row + np, || Cell::new(UNKNOWN));
+    }
+
+    /// The plane of the oriented triangle `v` (a row of the cache, made on first use).
+    fn plane(&mut self, v: [u32; 3]) -> Plane {
+        let (key, even) = sort3(v);
+        let next = self.rows.len() as u32;
+        let row = *self.rows.entry(key).or_insert(next);
+        if row == next {
+            self.row_keys.push(key);
+            let np = self.pts.len();
+            self.orient
+                .resize(self.orient.len() + np, Cell::new(UNKNOWN));
         }
-        for c in &self.sides[row..row + np] {
-            c.set(UNKNOWN);
-        }
+        Plane { row, even }
     }
 
     fn kill_face(&mut self, f: u32) {
@@ -472,6 +562,41 @@ impl Searcher {
             self.front_deg[x as usize] -= 1;
         }
         self.removed_log.push(f);
+        let i = self.front_pos[f as usize] as usize;
+        let last_box = self.front_box.pop();
+        if let Some(last) = self.front.pop()
+            && last != f
+            && let Some(b) = last_box
+        {
+            self.front[i] = last;
+            self.front_box[i] = b;
+            self.front_pos[last as usize] = i as u32;
+        }
+    }
+
+    /// Undo [`Self::kill_face`] (in exact reverse order of the kills since).
+    fn revive_face(&mut self, f: u32) {
+        let face = &mut self.faces[f as usize];
+        face.alive = true;
+        let v = face.v;
+        self.map.insert(canon(v), f);
+        for &x in &v {
+            self.front_deg[x as usize] += 1;
+        }
+        let b = (face.lo, face.hi);
+        let i = self.front_pos[f as usize] as usize;
+        let n = self.front.len();
+        if i < n {
+            let moved = self.front[i];
+            self.front_pos[moved as usize] = n as u32;
+            self.front.push(moved);
+            self.front_box.push(self.front_box[i]);
+            self.front[i] = f;
+            self.front_box[i] = b;
+        } else {
+            self.front.push(f);
+            self.front_box.push(b);
+        }
     }
 
     #[inline]
@@ -490,43 +615,36 @@ impl Searcher {
         orient3d(p[a as usize], p[b as usize], p[c as usize], p[d as usize])
     }
 
-    /// [`Self::o`] against the plane of face `f`, cached per face and point.
+    /// [`Self::o`] against the plane of face `f` (cached).
     #[inline]
     fn side(&self, f: u32, x: u32) -> Sign {
-        let cell = &self.sides[f as usize * self.pts.len() + x as usize];
-        match cell.get() {
+        self.outer(self.faces[f as usize].plane, x)
+    }
+
+    /// Orientation of `x` against the oriented plane `pl` (cached): for a face of a candidate
+    /// tet, positive outside the tet.
+    #[inline]
+    fn outer(&self, pl: Plane, x: u32) -> Sign {
+        let np = self.pts.len();
+        let cell = &self.orient[pl.row as usize * np + x as usize];
+        let s = match cell.get() {
             1 => Sign::Positive,
             -1 => Sign::Negative,
             0 => Sign::Zero,
             _ => {
-                let v = self.faces[f as usize].v;
-                let s = self.o(v[0], v[1], v[2], x);
+                let s = self.o_row(pl.row, x);
                 cell.set(s.as_i32() as i8);
                 s
             }
-        }
+        };
+        s.times(pl.even)
     }
 
-    /// Orientation of `x` against plane `pl`, positive outside the tet.
-    #[inline]
-    fn outer(&self, pl: Plane, x: u32) -> Sign {
-        match pl {
-            Plane::Face(f, flip) => self.side(f, x).times(!flip),
-            Plane::Tri(k, v) => {
-                let cell = &self.raw[k * self.pts.len() + x as usize];
-                let (st, val) = cell.get();
-                if st == self.raw_stamp.get() {
-                    return match val {
-                        1 => Sign::Positive,
-                        -1 => Sign::Negative,
-                        _ => Sign::Zero,
-                    };
-                }
-                let s = self.o(v[0], v[1], v[2], x);
-                cell.set((self.raw_stamp.get(), s.as_i32() as i8));
-                s
-            }
-        }
+    /// Orientation of `x` against the sorted triangle of row `row` (uncached).
+    #[inline(never)]
+    fn o_row(&self, row: u32, x: u32) -> Sign {
+        let v = self.row_keys[row as usize];
+        self.o(v[0], v[1], v[2], x)
     }
 
     /// Is `other` on the closed outer side of plane `pl` (face `fv`), touching it only at
@@ -589,28 +707,24 @@ impl Searcher {
         tri_tri(&fp, &gp) == TriTri::Improper
     }
 
-    /// Does segment `xy` meet the closed triangle `t` (no corner shared)? `sx`, `sy`: the
-    /// orientations of `x`, `y` against `t`'s plane (in any one sign convention).
+    /// Does segment `xy` meet the closed triangle `t` (no corner shared)? `sx`, `sy`: the exact
+    /// orientations of `x`, `y` against `t` in its own orientation (every plane passed to
+    /// [`Self::tri_conflict`] is oriented like its triangle).
     fn seg_meets(&self, x: u32, y: u32, sx: Sign, sy: Sign, t: [u32; 3]) -> bool {
         if sx != Sign::Zero && sx == sy {
             return false;
         }
-        let p = &self.pts;
-        let tp = t.map(|i| p[i as usize]);
         if sx == Sign::Zero && sy == Sign::Zero {
+            let p = &self.pts;
+            let tp = t.map(|i| p[i as usize]);
             return seg_tri(p[x as usize], p[y as usize], &tp).meets();
         }
         // The line crosses the plane at one point; its barycentric signs are the orientations
         // of the line against the triangle's edges, times the sign of its direction · normal.
-        let ox = self.o(t[0], t[1], t[2], x);
-        let oy = self.o(t[0], t[1], t[2], y);
-        let dn_positive = oy == Sign::Positive || ox == Sign::Negative;
-        let lam = [
-            self.o4(x, y, t[1], t[2]).times(dn_positive),
-            self.o4(x, y, t[2], t[0]).times(dn_positive),
-            self.o4(x, y, t[0], t[1]).times(dn_positive),
-        ];
-        !lam.contains(&Sign::Negative)
+        let dn_positive = sy == Sign::Positive || sx == Sign::Negative;
+        [(t[1], t[2]), (t[2], t[0]), (t[0], t[1])]
+            .iter()
+            .all(|&(a, b)| self.o4(x, y, a, b).times(dn_positive) != Sign::Negative)
     }
 
     /// Plain exact orientation of four distinct points.
@@ -620,19 +734,18 @@ impl Searcher {
         orient3d(p[a as usize], p[b as usize], p[c as usize], p[d as usize])
     }
 
-    /// The outward planes of the candidate tet `face + p`.
+    /// The outward faces of the candidate tet `face + p` and their planes.
     #[inline]
-    fn cand_planes(&self, f: u32, p: u32) -> ([[u32; 3]; 4], [Plane; 4]) {
-        self.raw_stamp.set(self.raw_stamp.get().wrapping_add(1));
+    fn cand_planes(&mut self, f: u32, p: u32) -> ([[u32; 3]; 4], [Plane; 4]) {
         let v = self.faces[f as usize].v;
         let tf = tet_faces([v[0], v[1], v[2], p]);
         (
             tf,
             [
-                Plane::Tri(0, tf[0]),
-                Plane::Tri(1, tf[1]),
-                Plane::Tri(2, tf[2]),
-                Plane::Face(f, true),
+                self.plane(tf[0]),
+                self.plane(tf[1]),
+                self.plane(tf[2]),
+                self.faces[f as usize].plane.flip(),
             ],
         )
     }
@@ -668,17 +781,10 @@ impl Searcher {
                 continue;
             }
             let (lo, hi) = bbox4(&corners);
-            let (tf, planes) = self.cand_planes(f as u32, p);
-            let t = [v[0], v[1], v[2], p];
-            if self.contains_point(t, &planes, lo, hi)
-                || self.hits_front(t, &tf, &planes, f as u32, lo, hi)
-            {
-                continue;
-            }
             self.cands.push(Cand {
                 p,
                 q,
-                dead: false,
+                state: UNCHECKED,
                 lo,
                 hi,
             });
@@ -688,6 +794,72 @@ impl Searcher {
         face.c0 = start as u32;
         face.c1 = self.cands.len() as u32;
         face.live = face.c1 - face.c0;
+        face.valid = 0;
+    }
+
+    /// Check conditions 3–4 of candidate `k` of face `f` against the current front; records
+    /// the outcome. Valid against the current front means valid: the region only shrinks.
+    fn validate(&mut self, f: u32, k: u32) -> bool {
+        let c = self.cands[k as usize];
+        let v = self.faces[f as usize].v;
+        let t = [v[0], v[1], v[2], c.p];
+        let (tf, planes) = self.cand_planes(f, c.p);
+        let ok = !(self.contains_point(t, &planes, c.lo, c.hi)
+            || self.hits_front(t, &tf, &planes, f, c.lo, c.hi));
+        self.set_state(f, k, if ok { VALID } else { DEAD });
+        ok
+    }
+
+    /// Set the state of candidate `k` of face `f`, logged for [`Self::undo`].
+    fn set_state(&mut self, f: u32, k: u32, new: u8) {
+        let old = self.cands[k as usize].state;
+        self.kill_log.push((k, f, old));
+        self.restate(f, k, new);
+    }
+
+    /// Set a candidate's state and keep its face's counts.
+    fn restate(&mut self, f: u32, k: u32, new: u8) {
+        let c = &mut self.cands[k as usize];
+        let face = &mut self.faces[f as usize];
+        match c.state {
+            VALID => face.valid -= 1,
+            DEAD => face.live += 1,
+            _ => {}
+        }
+        match new {
+            VALID => face.valid += 1,
+            DEAD => face.live -= 1,
+            _ => {}
+        }
+        c.state = new;
+    }
+
+    /// The number of candidates of face `f` with quality above the bound, exact when below
+    /// `limit` (else some number at least `limit`): unchecked ones are checked, best first,
+    /// only until `limit` valid ones are found.
+    fn count_upto(&mut self, f: u32, limit: u32) -> u32 {
+        let face = self.faces[f as usize];
+        if self.bound == f64::NEG_INFINITY
+            && (face.live == 0 || face.valid >= limit || face.valid == face.live)
+        {
+            return face.valid;
+        }
+        let mut n = 0;
+        for k in face.c0..face.c1 {
+            let c = self.cands[k as usize];
+            if c.q <= self.bound {
+                break;
+            }
+            n += match c.state {
+                VALID => 1,
+                UNCHECKED => self.validate(f, k) as u32,
+                _ => 0,
+            };
+            if n >= limit {
+                break;
+            }
+        }
+        n
     }
 
     /// For each edge of face `f`, the other front face across it when it is the only one and the
@@ -696,17 +868,17 @@ impl Searcher {
         let v = self.faces[f as usize].v;
         let mut w = [None; 3];
         let mut count = [0u8; 3];
-        for (h, face) in self.faces.iter().enumerate() {
-            if !face.alive || h as u32 == f {
+        for &h in &self.front {
+            if h == f {
                 continue;
             }
-            let hv = face.v;
+            let hv = self.faces[h as usize].v;
             for k in 0..3 {
                 let (a, b) = (v[k], v[(k + 1) % 3]);
                 // The face across runs the edge backwards.
                 if (0..3).any(|i| hv[i] == b && hv[(i + 1) % 3] == a) {
                     count[k] += 1;
-                    w[k] = Some(h as u32);
+                    w[k] = Some(h);
                 }
                 if (0..3).any(|i| hv[i] == a && hv[(i + 1) % 3] == b) {
                     count[k] += 2;
@@ -763,11 +935,11 @@ impl Searcher {
         lo: P3,
         hi: P3,
     ) -> bool {
-        for (g, face) in self.faces.iter().enumerate().rev() {
-            if !face.alive || g as u32 == base {
+        for (&g, &(glo, ghi)) in self.front.iter().zip(&self.front_box).rev() {
+            if g == base || boxes_apart(lo, hi, glo, ghi) {
                 continue;
             }
-            if self.face_conflicts(t, tf, planes, g as u32, lo, hi) {
+            if self.face_conflicts(t, tf, planes, g) {
                 return true;
             }
         }
@@ -783,23 +955,10 @@ impl Searcher {
         tf: &[[u32; 3]; 4],
         planes: &[Plane; 4],
         gid: u32,
-        lo: P3,
-        hi: P3,
     ) -> bool {
         let g = self.faces[gid as usize].v;
-        let gp = g.map(|x| self.pts[x as usize]);
-        let mut glo = gp[0];
-        let mut ghi = gp[0];
-        for p in &gp[1..] {
-            for k in 0..3 {
-                glo[k] = glo[k].min(p[k]);
-                ghi[k] = ghi[k].max(p[k]);
-            }
-        }
-        if boxes_apart(lo, hi, glo, ghi) {
-            return false;
-        }
-        if tf.iter().any(|f| same_set(*f, g)) {
+        // All three corners in the tet: g is one of its faces.
+        if g.iter().all(|x| t.contains(x)) {
             return false;
         }
         // g's plane (cached) with the tet on one closed side, touching only at corners of g.
@@ -822,7 +981,8 @@ impl Searcher {
                 return false;
             }
         }
-        (0..3).any(|k| self.tri_conflict(tf[k], planes[k], g, Plane::Face(gid, false)))
+        let gpl = self.faces[gid as usize].plane;
+        (0..3).any(|k| self.tri_conflict(tf[k], planes[k], g, gpl))
     }
 
     /// Do the candidate tet `c` (outward faces `cf`, planes `cp`) and the new tet (faces `tf`,
@@ -874,37 +1034,44 @@ impl Searcher {
             self.uses[x as usize] += 1;
         }
         let tf = tet_faces(t);
-        let mut tp = [Plane::Face(fi, true); 4];
+        let mut tp = [face.plane.flip(); 4];
         let first_new = self.faces.len();
+        // Kills before pushes: the undo pops new faces off the end of `front`.
+        let mut new = [false; 3];
         for k in 0..3 {
             let g = tf[k];
             let rev = [g[0], g[2], g[1]];
             if let Some(&h) = self.map.get(&canon(rev)) {
                 self.kill_face(h);
-                tp[k] = Plane::Face(h, true);
+                tp[k] = self.faces[h as usize].plane.flip();
             } else {
-                tp[k] = Plane::Face(self.faces.len() as u32, false);
-                self.push_face(g);
+                new[k] = true;
+            }
+        }
+        for k in 0..3 {
+            if new[k] {
+                self.push_face(tf[k]);
+                tp[k] = self.faces[self.faces.len() - 1].plane;
             }
         }
         // Filter the candidates of the other live faces against the new tet.
         let (tlo, thi) = (cand.lo, cand.hi);
-        for f in 0..first_new {
+        // Only checked ones: unchecked ones are checked against the front when needed.
+        for i in 0..self.front.len() {
+            let f = self.front[i] as usize;
             let fr = self.faces[f];
-            if !fr.alive || fr.live == 0 {
+            if f >= first_new || fr.valid == 0 {
                 continue;
             }
             for k in fr.c0..fr.c1 {
                 let c = self.cands[k as usize];
-                if c.dead || boxes_apart(c.lo, c.hi, tlo, thi) {
+                if c.state != VALID || boxes_apart(c.lo, c.hi, tlo, thi) {
                     continue;
                 }
                 let ct = [fr.v[0], fr.v[1], fr.v[2], c.p];
                 let (cf, cp) = self.cand_planes(f as u32, c.p);
                 if self.tets_conflict(ct, &cf, &cp, t, &tf, &tp) {
-                    self.cands[k as usize].dead = true;
-                    self.faces[f].live -= 1;
-                    self.kill_log.push(k);
+                    self.set_state(f as u32, k, DEAD);
                 }
             }
         }
@@ -918,34 +1085,27 @@ impl Searcher {
             return;
         };
         self.worst.pop();
+        // States first: the log may name candidates of faces added at this level.
+        while self.kill_log.len() > l.kill_len as usize {
+            if let Some((k, f, old)) = self.kill_log.pop() {
+                self.restate(f, k, old);
+            }
+        }
         while self.faces.len() > l.faces_len as usize {
             if let Some(f) = self.faces.pop() {
                 self.map.remove(&canon(f.v));
                 for &x in &f.v {
                     self.front_deg[x as usize] -= 1;
                 }
+                self.front.pop();
+                self.front_box.pop();
+                self.front_pos.pop();
             }
         }
         self.cands.truncate(l.cands_len as usize);
-        while self.kill_log.len() > l.kill_len as usize {
-            if let Some(k) = self.kill_log.pop() {
-                self.cands[k as usize].dead = false;
-                // Find the owning face: the one whose range holds k (alive ones only were
-                // filtered).
-                if let Some(f) = self.owner(k) {
-                    self.faces[f].live += 1;
-                }
-            }
-        }
         while self.removed_log.len() > l.removed_len as usize {
             if let Some(f) = self.removed_log.pop() {
-                let face = &mut self.faces[f as usize];
-                face.alive = true;
-                let v = face.v;
-                self.map.insert(canon(v), f);
-                for &x in &v {
-                    self.front_deg[x as usize] += 1;
-                }
+                self.revive_face(f);
             }
         }
         for &x in &l.tet {
@@ -953,37 +1113,42 @@ impl Searcher {
         }
     }
 
-    /// The face whose candidate range holds candidate `k` (ranges are disjoint and increasing).
-    fn owner(&self, k: u32) -> Option<usize> {
-        let i = self.faces.partition_point(|f| f.c1 <= k);
-        (i < self.faces.len() && self.faces[i].c0 <= k).then_some(i)
-    }
-
     fn dfs(&mut self) -> Flow {
         self.nodes += 1;
         if self.nodes > self.budget {
             return Flow::Abort;
         }
+        // The face with the fewest candidates, the first such in face order; a face without
+        // any prunes. Candidates are checked lazily: a face is first guessed by its upper bound,
+        // then every other face is checked only until it cannot win.
         let mut pick = None;
         let mut fewest = u32::MAX;
-        for (f, face) in self.faces.iter().enumerate() {
-            if !face.alive {
-                continue;
-            }
-            let n = if self.bound > f64::NEG_INFINITY {
-                (face.c0..face.c1)
-                    .filter(|&k| {
-                        let c = &self.cands[k as usize];
-                        !c.dead && c.q > self.bound
-                    })
-                    .count() as u32
-            } else {
-                face.live
-            };
+        let guess = self
+            .front
+            .iter()
+            .min_by_key(|&&f| (self.faces[f as usize].live, f))
+            .map(|&f| f as usize);
+        if let Some(g) = guess {
+            let n = self.count_upto(g as u32, u32::MAX);
             if n == 0 {
                 return Flow::Continue;
             }
-            if n < fewest {
+            fewest = n;
+            pick = Some(g);
+        }
+        for i in 0..self.front.len() {
+            let Some(p) = pick else { break };
+            let f = self.front[i] as usize;
+            if f == p {
+                continue;
+            }
+            // Beats the pick with fewer candidates, or as many and an earlier index.
+            let limit = if f < p { fewest + 1 } else { fewest };
+            let n = self.count_upto(f as u32, limit);
+            if n == 0 {
+                return Flow::Continue;
+            }
+            if n < limit {
                 fewest = n;
                 pick = Some(f);
             }
@@ -1009,11 +1174,11 @@ impl Searcher {
         let face = self.faces[f];
         for k in face.c0..face.c1 {
             let c = self.cands[k as usize];
-            if c.dead {
-                continue;
-            }
             if c.q <= self.bound {
                 break;
+            }
+            if c.state == DEAD || (c.state == UNCHECKED && !self.validate(f as u32, k)) {
+                continue;
             }
             self.apply(f as u32, k);
             let r = self.dfs();
@@ -1045,8 +1210,6 @@ mod tests {
         }
         let mut s = Searcher::new();
         s.pts = pts.clone();
-        s.raw = vec![Cell::new((0, 0)); 3 * pts.len()];
-        s.raw_stamp.set(1);
         let n = pts.len() as u64;
         let mut seed = 12345u64;
         let mut next = || {
@@ -1067,8 +1230,8 @@ mod tests {
             if g[0] == g[2] || is_degenerate(&fp) || is_degenerate(&gp) || same_set(f, g) {
                 continue;
             }
-            s.raw_stamp.set(s.raw_stamp.get() + 1);
-            let got = s.tri_conflict(f, Plane::Tri(0, f), g, Plane::Tri(1, g));
+            let (fpl, gpl) = (s.plane(f), s.plane(g));
+            let got = s.tri_conflict(f, fpl, g, gpl);
             assert_eq!(got, tri_tri(&fp, &gp) == TriTri::Improper, "{f:?} {g:?}");
             checked += 1;
         }
