@@ -541,8 +541,16 @@ fn mesh_the_bundled_example_and_report() {
 fn mesh_sizing_options() {
     let dir = tempfile::tempdir().unwrap();
     let brain = brain_surface();
+    // Sizing only: the later stages have tests of their own.
     let n_tets = |args: &[&str]| {
-        let mut a = vec!["mesh", s(&brain), "--json"];
+        let mut a = vec![
+            "mesh",
+            s(&brain),
+            "--json",
+            "--no-recover",
+            "--no-improve",
+            "--no-smooth",
+        ];
         a.extend_from_slice(args);
         json_of(&biotet(&a))["pipeline"]["n_tets"].as_u64().unwrap()
     };
