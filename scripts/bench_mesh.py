@@ -103,8 +103,11 @@ def run_tetgen_binary(surface, switches, tmp, repeat):
     exe = shutil.which("tetgen")
     if not exe:
         return None, "tetgen binary not found (apt-get install tetgen)", None
-    src = os.path.join(tmp, "tg_input.stl")
-    shutil.copy(surface, src)
+    # TetGen 1.5's STL reader aborts on these files; hand it the same surface as OFF.
+    src = os.path.join(tmp, "tg_input.off")
+    r = subprocess.run([BIOTET, "convert", surface, "-o", src, "--quiet"], capture_output=True, text=True)
+    if r.returncode != 0:
+        return None, r.stderr.strip(), None
     rows = []
     import re
     for _ in range(repeat):

@@ -3,7 +3,6 @@
 
 use crate::{Common, progress::Stage};
 use anyhow::Result;
-use biotet::SurfaceMesh;
 use biotet::lastresort::{ImproveOptions, Metric, improve};
 use biotet::quality::{QualityReport, forced};
 use serde_json::json;
@@ -44,12 +43,7 @@ pub struct Args {
 pub fn run(a: Args) -> Result<ExitCode> {
     let stage = Stage::start(a.common.quiet, format!("reading {}", a.mesh.display()));
     let mut mesh = super::input::tet_mesh(&a.mesh, a.common)?;
-    let mut surface: Option<SurfaceMesh> = None;
-    for s in &a.surfaces {
-        stage.set(format!("reading {}", s.display()));
-        let (m, _) = super::input::surface(s, a.common)?;
-        surface.get_or_insert_with(SurfaceMesh::default).append(&m);
-    }
+    let surface = super::input::surfaces(&a.surfaces, a.common, &stage)?;
     let (metric, threshold) = match a.metric {
         MetricArg::Dihedral => (Metric::Dihedral, a.threshold.unwrap_or(10.0)),
         MetricArg::Q => (Metric::Q, a.threshold.unwrap_or(0.2)),

@@ -55,3 +55,18 @@ pub fn surface(path: &Path, common: Common) -> Result<(SurfaceMesh, ValidationRe
     }
     Ok((mesh, report))
 }
+
+/// Read and validate several surfaces into one (`None` when no path is given).
+pub fn surfaces(
+    paths: &[std::path::PathBuf],
+    common: Common,
+    stage: &crate::progress::Stage,
+) -> Result<Option<SurfaceMesh>> {
+    let mut out: Option<SurfaceMesh> = None;
+    for s in paths {
+        stage.set(format!("reading {}", s.display()));
+        let (m, _) = surface(s, common)?;
+        out.get_or_insert_with(SurfaceMesh::default).append(&m);
+    }
+    Ok(out)
+}

@@ -3,7 +3,6 @@
 
 use crate::{Common, EXIT_INVALID, progress::Stage};
 use anyhow::{Context, Result};
-use biotet::SurfaceMesh;
 use biotet::lastresort::{RecoverOptions, recover};
 use serde_json::json;
 use std::path::PathBuf;
@@ -37,12 +36,7 @@ pub struct Args {
 pub fn run(a: Args) -> Result<ExitCode> {
     let stage = Stage::start(a.common.quiet, format!("reading {}", a.mesh.display()));
     let mut mesh = super::input::tet_mesh(&a.mesh, a.common)?;
-    let mut surface = SurfaceMesh::default();
-    for s in &a.surfaces {
-        stage.set(format!("reading {}", s.display()));
-        let (m, _) = super::input::surface(s, a.common)?;
-        surface.append(&m);
-    }
+    let surface = super::input::surfaces(&a.surfaces, a.common, &stage)?.unwrap_or_default();
     stage.set("recovering the boundary");
     let opts = RecoverOptions {
         allow_interior_steiner: a.allow_interior_steiner,

@@ -3,7 +3,6 @@
 
 use crate::{Common, plot, progress::Stage};
 use anyhow::{Context, Result};
-use biotet::SurfaceMesh;
 use biotet::quality::QualityReport;
 use biotet::smooth::{Boundary, SmoothOptions, smooth, solid_angle_share_below};
 use serde_json::json;
@@ -58,12 +57,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
     }
     let stage = Stage::start(a.common.quiet, format!("reading {}", a.mesh.display()));
     let mut mesh = super::input::tet_mesh(&a.mesh, a.common)?;
-    let mut surface: Option<SurfaceMesh> = None;
-    for s in &a.surfaces {
-        stage.set(format!("reading {}", s.display()));
-        let (m, _) = super::input::surface(s, a.common)?;
-        surface.get_or_insert_with(SurfaceMesh::default).append(&m);
-    }
+    let surface = super::input::surfaces(&a.surfaces, a.common, &stage)?;
     stage.set("measuring");
     let before = QualityReport::of(&mesh);
     let share_before = solid_angle_share_below(&mesh, 0.2);
