@@ -11,7 +11,8 @@ own "Total running seconds" (binary). Peak memory is the process's peak RSS minu
 resets the peak after reading the surface; the pip child records its RSS before the call). Quality comes from one
 routine for all tools: `biotet quality --json` on each output; missing input triangles from `biotet check --surface`.
 
---scaling meshes the first surface at several uniform sizes and prints seconds per tet (dissertation fig. 2.16).
+--scaling meshes the first surface at several uniform sizes with the deployment stages only (template, Delaunay,
+outside removal; `--no-recover --no-improve --no-smooth`) and prints seconds per tet (dissertation fig. 2.16).
 """
 import argparse, json, os, shutil, statistics, subprocess, sys, tempfile, textwrap, time
 
@@ -184,11 +185,11 @@ def main():
             s = a.surfaces[0]
             print("\n| uniform size | points | tets | seconds (median) | µs per tet | template MB | peak MB |")
             print("|---|---|---|---|---|---|---|")
-            for h in ["4", "3", "2", "1.5", "1.2"]:
+            for h in ["4", "3", "2", "1.5"]:
                 out = os.path.join(tmp, "scale.vtu")
                 rows = []
                 for _ in range(a.repeat):
-                    j = biotet_json("mesh", s, "--size", h)
+                    j = biotet_json("mesh", s, "--size", h, "--no-recover", "--no-improve", "--no-smooth")
                     rows.append({"seconds": j["pipeline"]["seconds_total"], "tets": j["pipeline"]["n_tets"],
                                  "points": j["pipeline"]["n_points"], "tmpl": j["pipeline"]["template"]["bytes"],
                                  "mem_kb": j["peak_rss_kb"] - j["rss_before_kb"]})
