@@ -2,7 +2,6 @@
 
 use crate::{Common, progress::Stage};
 use anyhow::Result;
-use biotet::SurfaceMesh;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -13,8 +12,12 @@ pub struct Args {
     mesh: PathBuf,
     /// A surface whose every triangle must be a face of the mesh (matched by exact
     /// coordinates, either orientation). Repeat for several surfaces.
+    /// Several closed shells make regions as in `biotet mesh` (innermost first).
     #[arg(long = "surface", short = 's', value_name = "SURFACE")]
     surfaces: Vec<PathBuf>,
+    /// Labels of one surface file's shells in order, as FILE=N[,N...], as for `biotet mesh`.
+    #[arg(long, value_name = "FILE=N[,N...]")]
+    label: Vec<String>,
     #[command(flatten)]
     common: Common,
 }
@@ -23,12 +26,11 @@ pub struct Args {
 pub fn run(a: Args) -> Result<ExitCode> {
     let stage = Stage::start(a.common.quiet, format!("reading {}", a.mesh.display()));
     let mesh = super::input::tet_mesh(&a.mesh, a.common)?;
-    let mut surface: Option<SurfaceMesh> = None;
-    for s in &a.surfaces {
-        stage.set(format!("reading {}", s.display()));
-        let (m, _) = super::input::surface(s, a.common)?;
-        surface.get_or_insert_with(SurfaceMesh::default).append(&m);
-    }
+    let surface = if a.surfaces.is_empty() {
+        None
+    } else {
+        Some(super::input::labelled_surface(&a.surfaces, &a.label, a.common, &stage)?.0)
+    };
     stage.set("checking");
     let report = biotet::check::check(&mesh, surface.as_ref());
     drop(stage);

@@ -1,10 +1,12 @@
 //! Reading inputs with the CLI's messages: every error names the file.
 
 use crate::Common;
+use crate::progress::Stage;
 use anyhow::{Context, Result};
+use biotet::mesh::shells::{Part, Shell, assemble};
 use biotet::mesh::validate::{ValidateOptions, ValidationReport, validate_surface};
 use biotet::{SurfaceMesh, TetMesh};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Read a tet mesh, telling the user about tets that had to be reoriented.
 pub fn tet_mesh(path: &Path, common: Common) -> Result<TetMesh> {
@@ -56,17 +58,100 @@ pub fn surface(path: &Path, common: Common) -> Result<(SurfaceMesh, ValidationRe
     Ok((mesh, report))
 }
 
-/// Read and validate several surfaces into one (`None` when no path is given).
-pub fn surfaces(
-    paths: &[std::path::PathBuf],
-    common: Common,
-    stage: &crate::progress::Stage,
-) -> Result<Option<SurfaceMesh>> {
-    let mut out: Option<SurfaceMesh> = None;
-    for s in paths {
-        stage.set(format!("reading {}", s.display()));
-        let (m, _) = surface(s, common)?;
-        out.get_or_insert_with(SurfaceMesh::default).append(&m);
+/// `--label FILE=N[,N...]` as labels per input file.
+pub fn parse_labels(items: &[String], files: &[PathBuf]) -> Result<Vec<Option<Vec<u32>>>> {
+    let mut out = vec![None; files.len()];
+    for item in items {
+        let (f, l) = item
+            .rsplit_once('=')
+            .with_context(|| format!("--label {item}: expected FILE=N[,N...]"))?;
+        let i = files
+            .iter()
+            .position(|p| p.as_os_str() == f || p.file_name().is_some_and(|n| n == f))
+            .with_context(|| format!("--label {item}: {f} is not one of the input surfaces"))?;
+        let v: Result<Vec<u32>, _> = l.split(',').map(|x| x.trim().parse::<u32>()).collect();
+        out[i] = Some(v.with_context(|| format!("--label {item}: bad label"))?);
     }
     Ok(out)
+}
+
+/// Several closed surfaces as one labelled, validated surface: every closed shell encloses a
+/// region, innermost first (see `biotet::mesh::shells`). Returns the surface, its shells and a
+/// name for messages.
+pub fn labelled_surface(
+    paths: &[PathBuf],
+    labels: &[String],
+    common: Common,
+    stage: &Stage,
+) -> Result<(SurfaceMesh, Vec<Shell>, String)> {
+    let labels = parse_labels(labels, paths)?;
+    let mut parts = Vec::new();
+    for (i, p) in paths.iter().enumerate() {
+        stage.set(format!("reading {}", p.display()));
+        let read = biotet_io::read_surface(p)?;
+        if read.welded > 0 && !common.quiet && !common.json {
+            eprintln!(
+                "note: {}: welded {} duplicate vertices",
+                p.display(),
+                read.welded
+            );
+        }
+        parts.push(Part {
+            surface: read.mesh,
+            labels: labels[i].clone(),
+        });
+    }
+    let name = paths
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect::<Vec<_>>()
+        .join(" + ");
+    stage.set("validating the surface");
+    let (s, shells) = assemble_parts(parts, &name, paths, common)?;
+    Ok((s, shells, name))
+}
+
+/// Assemble and validate parts, telling the user about flipped shells and regions.
+pub fn assemble_parts(
+    parts: Vec<Part>,
+    name: &str,
+    paths: &[PathBuf],
+    common: Common,
+) -> Result<(SurfaceMesh, Vec<Shell>)> {
+    let (mut surface, shells) =
+        assemble(parts).with_context(|| format!("{name}: cannot assemble the surfaces"))?;
+    validate_surface(&mut surface, &ValidateOptions::default())
+        .with_context(|| format!("{name}: invalid surface"))?;
+    if !common.quiet && !common.json {
+        for (k, sh) in shells.iter().enumerate() {
+            if sh.flipped {
+                eprintln!(
+                    "note: {}: shell {k} ({} triangles) faced inward and was flipped",
+                    paths
+                        .get(sh.part)
+                        .map_or(name.to_string(), |p| p.display().to_string()),
+                    sh.n_triangles
+                );
+            }
+        }
+        if shells.len() > 1 {
+            let desc: Vec<String> = shells
+                .iter()
+                .map(|sh| match sh.parent {
+                    Some(p) => format!("{} (inside {})", sh.label, shells[p].label),
+                    None => sh.label.to_string(),
+                })
+                .collect();
+            eprintln!("note: {} shells, regions {}", shells.len(), desc.join(", "));
+        }
+    }
+    Ok((surface, shells))
+}
+
+/// [`labelled_surface`] for commands whose surface is optional (`None` without paths).
+pub fn surfaces(paths: &[PathBuf], common: Common, stage: &Stage) -> Result<Option<SurfaceMesh>> {
+    if paths.is_empty() {
+        return Ok(None);
+    }
+    Ok(Some(labelled_surface(paths, &[], common, stage)?.0))
 }

@@ -2,8 +2,7 @@
 
 use crate::{Common, plot, progress::Stage};
 use anyhow::{Context, Result, bail};
-use biotet::mesh::shells::{Part, assemble};
-use biotet::mesh::validate::{ValidateOptions, validate_surface};
+use biotet::mesh::shells::Part;
 use biotet::pipeline::{PipelineOptions, mesh_surface};
 use biotet::quality::{QualityReport, forced};
 use biotet::sizing::{SizeSpec, Sizing, SizingOptions};
@@ -96,23 +95,6 @@ pub struct Args {
     common: Common,
 }
 
-/// `--label FILE=N[,N...]` as labels per input file.
-fn parse_labels(items: &[String], files: &[PathBuf]) -> Result<Vec<Option<Vec<u32>>>> {
-    let mut out = vec![None; files.len()];
-    for item in items {
-        let (f, l) = item
-            .rsplit_once('=')
-            .with_context(|| format!("--label {item}: expected FILE=N[,N...]"))?;
-        let i = files
-            .iter()
-            .position(|p| p.as_os_str() == f || p.file_name().is_some_and(|n| n == f))
-            .with_context(|| format!("--label {item}: {f} is not one of the input surfaces"))?;
-        let v: Result<Vec<u32>, _> = l.split(',').map(|x| x.trim().parse::<u32>()).collect();
-        out[i] = Some(v.with_context(|| format!("--label {item}: bad label"))?);
-    }
-    Ok(out)
-}
-
 fn parse_region_sizes(items: &[String]) -> Result<Vec<(u32, f64)>> {
     items
         .iter()
@@ -137,55 +119,17 @@ fn parse_region_sizes(items: &[String]) -> Result<Vec<(u32, f64)>> {
 pub fn run(a: Args) -> Result<ExitCode> {
     let clock = Instant::now();
     let stage = Stage::start(a.common.quiet, "reading the surface");
-    let labels = parse_labels(&a.label, &a.surfaces)?;
-    let mut parts = Vec::new();
-    let name = if a.surfaces.is_empty() {
-        parts.push(Part {
+    let (surface, shells, name) = if a.surfaces.is_empty() {
+        let part = Part {
             surface: biotet_io::stl::parse(EXAMPLE, EXAMPLE_NAME)?.mesh,
             labels: None,
-        });
-        EXAMPLE_NAME.to_string()
+        };
+        stage.set("validating the surface");
+        let (s, sh) = super::input::assemble_parts(vec![part], EXAMPLE_NAME, &[], a.common)?;
+        (s, sh, EXAMPLE_NAME.to_string())
     } else {
-        for (i, p) in a.surfaces.iter().enumerate() {
-            parts.push(Part {
-                surface: biotet_io::read_surface(p)?.mesh,
-                labels: labels[i].clone(),
-            });
-        }
-        a.surfaces
-            .iter()
-            .map(|p| p.display().to_string())
-            .collect::<Vec<_>>()
-            .join(" + ")
+        super::input::labelled_surface(&a.surfaces, &a.label, a.common, &stage)?
     };
-    stage.set("validating the surface");
-    let (mut surface, shells) =
-        assemble(parts).with_context(|| format!("{name}: cannot assemble the surfaces"))?;
-    validate_surface(&mut surface, &ValidateOptions::default())
-        .with_context(|| format!("{name}: invalid surface"))?;
-    if !a.common.quiet && !a.common.json {
-        for (k, sh) in shells.iter().enumerate() {
-            if sh.flipped {
-                eprintln!(
-                    "note: {}: shell {k} ({} triangles) faced inward and was flipped",
-                    a.surfaces
-                        .get(sh.part)
-                        .map_or(name.clone(), |p| p.display().to_string()),
-                    sh.n_triangles
-                );
-            }
-        }
-        if shells.len() > 1 {
-            let desc: Vec<String> = shells
-                .iter()
-                .map(|sh| match sh.parent {
-                    Some(p) => format!("{} (inside {})", sh.label, shells[p].label),
-                    None => sh.label.to_string(),
-                })
-                .collect();
-            eprintln!("note: {} shells, regions {}", shells.len(), desc.join(", "));
-        }
-    }
     let seconds_read = clock.elapsed().as_secs_f64();
     // Restart the peak-memory count so it measures meshing, not reading and validating (Linux).
     let _ = std::fs::write("/proc/self/clear_refs", "5");
