@@ -99,3 +99,47 @@ fn nested_brain_and_white_matter_mesh_into_two_regions() {
     assert!((vol[1] - grey).abs() / grey < 0.03, "{vol:?}");
     assert!((vol[2] - white).abs() / white < 0.03, "{vol:?}");
 }
+
+#[test]
+fn three_materials_with_a_triple_line_mesh_conformingly() {
+    // Two unit cubes touching along x = 1 (regions 1 and 2) inside a box (region 3): the three
+    // regions meet along the edges of the shared square, a triple line.
+    let a = cube_surface([0.0; 3], 1.0);
+    let b = cube_surface([1.0, 0.0, 0.0], 1.0);
+    let mut c = cube_surface([-1.0, -1.0, -1.0], 1.0);
+    for p in &mut c.points {
+        // Stretch to the box [-1, 3] x [-1, 2] x [-1, 2].
+        p[0] = if p[0] > -1.0 { 3.0 } else { -1.0 };
+        p[1] = if p[1] > -1.0 { 2.0 } else { -1.0 };
+        p[2] = if p[2] > -1.0 { 2.0 } else { -1.0 };
+    }
+    let (mut s, shells) = assemble(vec![
+        part(a, Some(vec![1])),
+        part(b, Some(vec![2])),
+        part(c, Some(vec![3])),
+    ])
+    .unwrap();
+    assert_eq!(shells[0].parent, Some(2));
+    assert_eq!(shells[1].parent, Some(2));
+    validate_surface(&mut s, &ValidateOptions::default()).unwrap();
+    let sizing = Sizing::uniform(0.4).unwrap();
+    let (mesh, report) =
+        mesh_surface(&s, &sizing, &PipelineOptions::default(), &mut |_| {}).unwrap();
+    let r = report.recover.as_ref().unwrap();
+    assert_eq!(r.missing_after, 0, "{r:?}");
+    let c = biotet::check::check(&mesh, Some(&s));
+    assert!(c.valid, "{c}");
+    let conf = c.surface.as_ref().unwrap();
+    assert_eq!(conf.n_found, s.triangles.len());
+    for i in &conf.interfaces {
+        assert_eq!(i.found, i.expected, "{:?}", i.labels);
+    }
+    // Region volumes are the volumes their surfaces enclose.
+    let mut vol = [0.0f64; 4];
+    for t in 0..mesh.tets.len() {
+        vol[mesh.labels[t] as usize] += volume(&mesh.corners(t));
+    }
+    for (l, v) in [(1, 1.0), (2, 1.0), (3, 36.0 - 2.0)] {
+        assert!((vol[l] - v).abs() < 1e-9 * 36.0, "region {l}: {} vs {v}", vol[l]);
+    }
+}
