@@ -775,3 +775,96 @@ fn recover_then_improve_a_mesh_made_without_them() {
         json_of(&biotet(&["quality", s(&rec), "--json"]))["n_points"]
     );
 }
+
+#[test]
+fn two_materials_check_and_open_in_meshio_with_their_labels() {
+    let dir = tempfile::tempdir().unwrap();
+    // A cube of side 4 around a cube of side 2: region 1 between them, region 2 inside.
+    let scaled = |k: f64, o: f64| {
+        cube_off(|_, pts| {
+            for p in pts.iter_mut() {
+                *p = p.map(|c| c * k + o);
+            }
+        })
+    };
+    let outer = dir.path().join("outer.off");
+    let inner = dir.path().join("inner.off");
+    std::fs::write(&outer, scaled(4.0, 0.0)).unwrap();
+    std::fs::write(&inner, scaled(2.0, 1.0)).unwrap();
+    let outs: Vec<PathBuf> = ["m.vtu", "m.mesh", "m.msh"]
+        .iter()
+        .map(|n| dir.path().join(n))
+        .collect();
+    let j = json_of(&biotet(&[
+        "mesh",
+        s(&outer),
+        s(&inner),
+        "--size",
+        "0.7",
+        "-o",
+        s(&outs[0]),
+        "--json",
+    ]));
+    let regions = j["quality"]["regions"].as_array().unwrap().clone();
+    assert_eq!(regions.len(), 2);
+    let v = |l: u64| {
+        regions.iter().find(|r| r["label"] == l).unwrap()["volume"]
+            .as_f64()
+            .unwrap()
+    };
+    assert!(
+        (v(1) - 56.0).abs() < 1e-9 && (v(2) - 8.0).abs() < 1e-9,
+        "{regions:?}"
+    );
+    let c = biotet(&[
+        "check",
+        s(&outs[0]),
+        "-s",
+        s(&outer),
+        "-s",
+        s(&inner),
+        "--json",
+    ]);
+    let cj: Value = serde_json::from_slice(&c.stdout).unwrap();
+    assert_eq!(cj["valid"], true, "{cj}");
+    for o in &outs[1..] {
+        let out = biotet(&["convert", s(&outs[0]), "-o", s(o)]);
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    // meshio reads each with its labels (skipped where Python or meshio is absent).
+    let probe = Command::new("python3")
+        .args(["-c", "import meshio"])
+        .output();
+    if !probe.is_ok_and(|o| o.status.success()) {
+        eprintln!("meshio not available: skipping the meshio part");
+        return;
+    }
+    let script = r#"
+import sys, meshio, numpy as np
+m = meshio.read(sys.argv[1])
+labels = set()
+for name, data in m.cell_data.items():
+    for block, cells in zip(data, m.cells):
+        if cells.type == "tetra":
+            labels |= set(int(x) for x in np.unique(block))
+print(sorted(labels))
+"#;
+    for o in &outs {
+        let r = Command::new("python3")
+            .args(["-c", script, s(o)])
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&r.stdout);
+        assert!(
+            r.status.success(),
+            "{}: {}",
+            o.display(),
+            String::from_utf8_lossy(&r.stderr)
+        );
+        assert!(
+            text.contains("1") && text.contains("2"),
+            "{}: labels {text}",
+            o.display()
+        );
+    }
+}

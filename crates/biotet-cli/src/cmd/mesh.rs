@@ -250,5 +250,27 @@ pub fn run(a: Args) -> Result<ExitCode> {
         );
         crate::emit(&text);
     }
+    if let Some(r) = &report.recover
+        && !r.is_complete()
+    {
+        if !a.common.quiet {
+            eprintln!(
+                "error: {name}: {} input triangles could not be recovered without new points on \
+                 the surface (the mesh was written for inspection); the first ones:",
+                r.missing_after
+            );
+            for u in r.unrecovered.iter().take(10) {
+                eprintln!(
+                    "  triangle {} at {:?}, smallest angle {:.4}°: {}",
+                    u.triangle, u.corners, u.min_angle_deg, u.reason
+                );
+            }
+            eprintln!(
+                "  (a size much finer than these triangles makes their cavities large: a size \
+                 closer to the surface's edges, or --size-from-surface, usually recovers them)"
+            );
+        }
+        return Ok(ExitCode::from(crate::EXIT_INVALID));
+    }
     Ok(ExitCode::SUCCESS)
 }

@@ -140,6 +140,10 @@ fn three_materials_with_a_triple_line_mesh_conformingly() {
         vol[mesh.labels[t] as usize] += volume(&mesh.corners(t));
     }
     for (l, v) in [(1, 1.0), (2, 1.0), (3, 36.0 - 2.0)] {
-        assert!((vol[l] - v).abs() < 1e-9 * 36.0, "region {l}: {} vs {v}", vol[l]);
+        assert!(
+            (vol[l] - v).abs() < 1e-9 * 36.0,
+            "region {l}: {} vs {v}",
+            vol[l]
+        );
     }
 }
