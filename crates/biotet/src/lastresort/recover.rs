@@ -77,7 +77,13 @@ pub struct RecoverOptions {
     pub allow_interior_steiner: bool,
     /// Remove the tets of region 0 (outside the surface) at the end.
     pub remove_outside: bool,
+    /// Each cell is first searched with this quality threshold ηe (fewer candidates, better
+    /// tets), then with [`SearchOptions::min_quality`] if that fails; at or below it, one search.
+    pub first_quality: f64,
 }
+
+/// Node budget of the first, higher-threshold try.
+const FIRST_TRY_NODES: u64 = 500;
 
 impl Default for RecoverOptions {
     fn default() -> Self {
@@ -91,6 +97,7 @@ impl Default for RecoverOptions {
             max_cavity_tets: 1500,
             allow_interior_steiner: false,
             remove_outside: true,
+            first_quality: 0.05,
         }
     }
 }
@@ -861,10 +868,29 @@ impl<'a> Recovery<'a> {
                     .filter(|(_, k)| **k == c)
                     .map(|(f, _)| *f),
             );
-            match self
-                .searcher
-                .fill(&cav.coords, &faces, &inner, &self.opts.search)
-            {
+            // A first, cheaper try among better tets only (ηe raised): fewer candidates, and
+            // fewer slivers for the sliver removal that follows; the configured search if not.
+            let mut first = None;
+            if self.opts.first_quality > self.opts.search.min_quality {
+                let o = SearchOptions {
+                    min_quality: self.opts.first_quality,
+                    max_nodes: self.opts.search.max_nodes.min(FIRST_TRY_NODES),
+                    ..self.opts.search
+                };
+                match self.searcher.fill(&cav.coords, &faces, &inner, &o) {
+                    Ok(f) => first = Some(f),
+                    Err(SearchError::NoFill { nodes_visited })
+                    | Err(SearchError::Budget { nodes_visited }) => *nodes += nodes_visited,
+                    Err(_) => {}
+                }
+            }
+            let result = match first {
+                Some(f) => Ok(f),
+                None => self
+                    .searcher
+                    .fill(&cav.coords, &faces, &inner, &self.opts.search),
+            };
+            match result {
                 Ok(f) => {
                     *nodes += f.nodes_visited;
                     out.extend(f.tets.iter().map(|t| t.map(|x| cav.points[x as usize])));
