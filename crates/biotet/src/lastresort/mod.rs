@@ -10,7 +10,7 @@
 //! Every combinatorial decision is an exact predicate (orient3d, exact segment–triangle and
 //! triangle–triangle tests); floating point only ranks tets by quality.
 
-mod cells;
+pub(crate) mod cells;
 pub mod improve;
 pub mod recover;
 pub mod search;

@@ -8,8 +8,15 @@
 //! of each shared triangle, an interface `[label A, label B]`. A shell labelled 0 is a cavity: its
 //! inside is not meshed.
 //!
+//! A part whose triangles meet more than two at an edge (a non-manifold surface, as a
+//! multi-material marching cubes writes: three regions along an edge) is labelled from its
+//! arrangement instead ([`label_arrangement`]): the triangles, taken on both sides, split space
+//! into cells by their exact angular order around every edge; nested cells are resolved by exact
+//! point location; each bounded region gets a label.
+//!
 //! Limits: shells touching only along an edge or at a vertex (without a shared triangle) join
-//! into one component; a shell sharing triangles with the shell around it is refused.
+//! into one component; a shell sharing triangles with the shell around it is refused; a
+//! non-manifold part must be the only part.
 //! [`crate::mesh::validate`] checks the result (closed regions, no intersections).
 
 use rustc_hash::FxHashMap;
@@ -56,6 +63,15 @@ pub enum AssembleError {
         /// The label.
         label: u32,
     },
+    /// A non-manifold part given with other parts.
+    #[error("a non-manifold surface (more than two triangles at an edge) must be given alone")]
+    NonManifoldWithOthers,
+    /// The triangles do not split space into consistent cells.
+    #[error(
+        "the triangles around edge ({0}, {1}) do not bound consistent regions (crossing or \
+         overlapping triangles)"
+    )]
+    Arrangement(u32, u32),
     /// A shell shares triangles with the shell around it.
     #[error(
         "shell {inner} shares triangles with shell {outer} around it (a region touching the \
@@ -125,8 +141,153 @@ fn components(tris: &[[u32; 3]]) -> (Vec<u32>, usize) {
     (comp, n as usize)
 }
 
+/// Whether some edge has more than two triangles.
+fn is_non_manifold(tris: &[[u32; 3]]) -> bool {
+    let mut count: FxHashMap<(u32, u32), u32> = Default::default();
+    for t in tris {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            let c = count.entry((a.min(b), a.max(b))).or_insert(0);
+            *c += 1;
+            if *c > 2 {
+                return true;
+            }
+        }
+    }
+    false
+}
+
+/// Label a (possibly non-manifold) surface from the cells its triangles bound: every bounded
+/// region gets a label, 1, 2, … in order of its first triangle, or `labels[k]` for the k-th.
+/// Triangle orientations are kept; `sides` are set.
+pub fn label_arrangement(
+    s: &SurfaceMesh,
+    labels: Option<&[u32]>,
+) -> Result<(SurfaceMesh, Vec<Shell>), AssembleError> {
+    let nt = s.triangles.len();
+    // Half-face 2t faces the triangle's front (its normal points into that cell), 2t+1 its back.
+    let mut half = Vec::with_capacity(2 * nt);
+    for t in &s.triangles {
+        half.push(*t);
+        half.push([t[0], t[2], t[1]]);
+    }
+    let mut cell = Vec::new();
+    let n = crate::lastresort::cells::Cells::default()
+        .split(&s.points, &half, &mut cell)
+        .map_err(|(a, b)| AssembleError::Arrangement(a, b))?;
+    // Each cell is a closed surface with normals into it: negative outward volume means it
+    // bounds a finite region from outside; positive, that it is the outer side of a solid (a
+    // hole in the region around it, or the boundary of the unbounded region).
+    let mut vol = vec![0.0f64; n];
+    let o = s.points.first().copied().unwrap_or([0.0; 3]);
+    for (h, f) in half.iter().enumerate() {
+        let [a, b, c] = f.map(|v| s.points[v as usize]);
+        vol[cell[h] as usize] += volume6(o, a, b, c);
+    }
+    let outer: Vec<usize> = (0..n).filter(|&c| vol[c] < 0.0).collect();
+    let mut region = vec![0u32; n];
+    for (k, &c) in outer.iter().enumerate() {
+        region[c] = match labels {
+            Some(l) if k < l.len() => l[k],
+            Some(l) => {
+                return Err(AssembleError::Labels {
+                    part: 0,
+                    shells: outer.len(),
+                    labels: l.len(),
+                });
+            }
+            None => k as u32 + 1,
+        };
+    }
+    if let Some(l) = labels
+        && l.len() != outer.len()
+    {
+        return Err(AssembleError::Labels {
+            part: 0,
+            shells: outer.len(),
+            labels: l.len(),
+        });
+    }
+    // A positive cell belongs to the innermost finite region around it, by point location
+    // against each negative cell's own triangles.
+    let tris_of = |c: usize| -> Vec<[u32; 3]> {
+        half.iter()
+            .zip(&cell)
+            .filter(|&(_, &k)| k as usize == c)
+            .map(|(f, _)| [f[0], f[2], f[1]]) // outward for the region inside
+            .collect()
+    };
+    let positive: Vec<usize> = (0..n).filter(|&c| vol[c] >= 0.0).collect();
+    if !positive.is_empty() && !outer.is_empty() {
+        let mut best: Vec<Option<(usize, f64)>> = vec![None; n];
+        for &c in &outer {
+            let shell = SurfaceMesh::closed(s.points.clone(), tris_of(c), 1);
+            let on: rustc_hash::FxHashSet<u32> =
+                shell.triangles.iter().flatten().copied().collect();
+            let loc = RegionLocator::new(&shell);
+            for &p in &positive {
+                let Some(&v) = half
+                    .iter()
+                    .zip(&cell)
+                    .filter(|&(_, &k)| k as usize == p)
+                    .flat_map(|(f, _)| f.iter())
+                    .find(|v| !on.contains(v))
+                else {
+                    continue;
+                };
+                if loc.locate(s.points[v as usize]) == Location::Region(1) {
+                    // The innermost container has the smallest volume.
+                    let size = -vol[c];
+                    if best[p].is_none_or(|(_, b)| size < b) {
+                        best[p] = Some((c, size));
+                    }
+                }
+            }
+        }
+        for &p in &positive {
+            region[p] = best[p].map_or(0, |(c, _)| region[c]);
+        }
+    }
+    let sides = (0..nt)
+        .map(|t| {
+            [
+                region[cell[2 * t + 1] as usize],
+                region[cell[2 * t] as usize],
+            ]
+        })
+        .collect();
+    let shells = outer
+        .iter()
+        .map(|&c| Shell {
+            part: 0,
+            label: region[c],
+            n_triangles: cell.iter().filter(|&&k| k as usize == c).count(),
+            parent: None,
+            flipped: false,
+        })
+        .collect();
+    Ok((
+        SurfaceMesh {
+            points: s.points.clone(),
+            triangles: s.triangles.clone(),
+            sides,
+        },
+        shells,
+    ))
+}
+
 /// Assemble parts into one surface with region labels; returns it and its shells.
 pub fn assemble(parts: Vec<Part>) -> Result<(SurfaceMesh, Vec<Shell>), AssembleError> {
+    if let Some(k) = parts
+        .iter()
+        .position(|p| is_non_manifold(&p.surface.triangles))
+    {
+        if parts.len() > 1 {
+            return Err(AssembleError::NonManifoldWithOthers);
+        }
+        let p = &parts[k];
+        return label_arrangement(&p.surface, p.labels.as_deref());
+    }
     // One welded point set.
     let mut points: Vec<[f64; 3]> = Vec::new();
     let mut index: FxHashMap<[u64; 3], u32> = Default::default();

@@ -147,3 +147,41 @@ fn three_materials_with_a_triple_line_mesh_conformingly() {
         );
     }
 }
+
+#[test]
+fn a_non_manifold_surface_is_labelled_from_its_cells() {
+    // Two unit cubes sharing the face x = 1, given as one surface with that face once: the
+    // edges of the shared square carry three triangles each.
+    let a = cube_surface([0.0; 3], 1.0);
+    let b = cube_surface([1.0, 0.0, 0.0], 1.0);
+    let mut s = a.clone();
+    let base = s.points.len() as u32;
+    s.points.extend(&b.points);
+    for t in &b.triangles {
+        let on_shared = t.iter().all(|&v| b.points[v as usize][0] == 1.0);
+        if !on_shared {
+            s.triangles.push(t.map(|v| v + base));
+            s.sides.push([1, 0]);
+        }
+    }
+    s.weld_exact();
+    let (mut s, shells) = assemble(vec![part(s, None)]).unwrap();
+    assert_eq!(shells.len(), 2);
+    // Every triangle has the outside or the other cube on its front; the shared square is the
+    // interface between regions 1 and 2.
+    assert_eq!(s.sides.iter().filter(|x| x[0] != 0 && x[1] != 0).count(), 2);
+    assert_eq!(s.sides.iter().filter(|x| x.contains(&0)).count(), 20);
+    validate_surface(&mut s, &ValidateOptions::default()).unwrap();
+    let sizing = Sizing::uniform(0.3).unwrap();
+    let (mesh, _) = mesh_surface(&s, &sizing, &PipelineOptions::default(), &mut |_| {}).unwrap();
+    let c = biotet::check::check(&mesh, Some(&s));
+    assert!(c.valid, "{c}");
+    let mut vol = [0.0f64; 3];
+    for t in 0..mesh.tets.len() {
+        vol[mesh.labels[t] as usize] += volume(&mesh.corners(t));
+    }
+    assert!(
+        (vol[1] - 1.0).abs() < 1e-12 && (vol[2] - 1.0).abs() < 1e-12,
+        "{vol:?}"
+    );
+}
