@@ -64,6 +64,21 @@ pub const EXIT_INVALID: u8 = 1;
 pub const EXIT_ERROR: u8 = 2;
 
 fn main() -> ExitCode {
+    // A closed stderr (`biotet mesh 2>&1 | head`) makes eprintln! panic: end quietly instead, as
+    // for a closed stdout; any other panic keeps the default report.
+    let default_hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let msg = info
+            .payload()
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| info.payload().downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        if msg.starts_with("failed printing to stderr") {
+            std::process::exit(EXIT_ERROR as i32);
+        }
+        default_hook(info);
+    }));
     let cli = Cli::parse();
     let json = std::env::args().any(|a| a == "--json");
     let result = match cli.command {
