@@ -5,6 +5,7 @@
 //! Every test that makes a mesh runs this on it; `biotet check` prints its report.
 
 use crate::geom::predicates::{Sign, in_exact_range, orient3d};
+use crate::mesh::coord_key;
 use crate::mesh::surface::SurfaceMesh;
 use crate::mesh::tet::{NO_NEIGHBOR, TET_FACES, TetMesh, sorted3};
 use crate::mesh::validate::{ValidateOptions, validate_surface};
@@ -95,12 +96,6 @@ impl CheckReport {
             self.problems.push(msg());
         }
     }
-}
-
-/// Exact coordinate key (so `-0.0 == 0.0`).
-#[inline]
-fn coord_key(p: &[f64; 3]) -> [u64; 3] {
-    p.map(|c| if c == 0.0 { 0 } else { c.to_bits() })
 }
 
 /// Check `mesh`, and if `surface` is given, that every surface triangle is a face of it.

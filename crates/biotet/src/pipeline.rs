@@ -11,6 +11,7 @@ use crate::delaunay::{Delaunay, DelaunayError};
 use crate::lastresort::{
     ImproveOptions, ImproveReport, RecoverError, RecoverOptions, RecoverReport, improve, recover,
 };
+use crate::mesh::coord_key;
 use crate::mesh::inside::{Location, RegionLocator, Transitions};
 use crate::mesh::surface::SurfaceMesh;
 use crate::mesh::tet::{NO_NEIGHBOR, TetMesh};
@@ -351,17 +352,16 @@ fn remove_outside(mesh: TetMesh) -> TetMesh {
 
 /// Input triangles that are not a face of any tet (matched by point coordinates).
 pub fn missing_triangles(mesh: &TetMesh, surface: &SurfaceMesh) -> usize {
-    let key = |p: &[f64; 3]| p.map(|c| if c == 0.0 { 0 } else { c.to_bits() });
     let mut index: FxHashMap<[u64; 3], u32> = Default::default();
     for (i, p) in surface.points.iter().enumerate() {
-        index.insert(key(p), i as u32);
+        index.insert(coord_key(p), i as u32);
     }
     // Mesh point -> surface point (u32::MAX for the others); only faces with three surface
     // points can be surface triangles, so only those are hashed.
     let on_surface: Vec<u32> = mesh
         .points
         .iter()
-        .map(|p| index.get(&key(p)).copied().unwrap_or(u32::MAX))
+        .map(|p| index.get(&coord_key(p)).copied().unwrap_or(u32::MAX))
         .collect();
     let mut faces: FxHashSet<[u32; 3]> = Default::default();
     for t in 0..mesh.tets.len() {

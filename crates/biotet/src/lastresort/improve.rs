@@ -30,6 +30,7 @@ use serde::Serialize;
 use super::search::{SearchOptions, Searcher};
 use crate::mesh::tet::{NO_NEIGHBOR, TET_FACES, TetMesh};
 use crate::quality::tet::{dihedral_angles, q_measure};
+use crate::quality::tri::min_angle_3d_deg;
 
 type P3 = [f64; 3];
 
@@ -149,18 +150,6 @@ fn measure(c: &[P3; 4], m: Metric) -> f64 {
             .fold(f64::INFINITY, f64::min)
             .to_degrees(),
     }
-}
-
-/// Smallest angle (radians) of a triangle.
-fn min_angle(c: &[P3; 3]) -> f64 {
-    use crate::geom::vec3::{cross, dot, norm, sub};
-    (0..3)
-        .map(|i| {
-            let u = sub(c[(i + 1) % 3], c[i]);
-            let v = sub(c[(i + 2) % 3], c[i]);
-            norm(cross(u, v)).atan2(dot(u, v))
-        })
-        .fold(f64::INFINITY, f64::min)
 }
 
 /// A tet in the queue, worst first.
@@ -479,12 +468,12 @@ impl<'a> Work<'a> {
     fn compute_forced(&self, tet: u32) -> bool {
         let tv = self.tets[tet as usize];
         let label = self.labels[tet as usize];
-        let lim = self.opts.forced_deg.to_radians();
+        let lim = self.opts.forced_deg;
         let fixed = |n: u32| n == NO_NEIGHBOR || self.labels[n as usize] != label;
         for (i, l) in TET_FACES.iter().enumerate() {
             if fixed(self.nb[tet as usize][i]) {
                 let c = l.map(|k| self.pts[tv[k] as usize]);
-                if min_angle(&c) < lim {
+                if min_angle_3d_deg(&c) < lim {
                     return true;
                 }
             }
@@ -493,7 +482,7 @@ impl<'a> Work<'a> {
         for e in crate::mesh::tet::TET_EDGES {
             let (a, b) = (tv[e[0]], tv[e[1]]);
             if let Some(w) = self.wedge(tet, a, b, label)
-                && w < lim
+                && w.to_degrees() < lim
             {
                 return true;
             }

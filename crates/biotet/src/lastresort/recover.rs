@@ -52,9 +52,10 @@ use super::search::{SearchError, SearchOptions, Searcher};
 use crate::delaunay::Delaunay;
 use crate::geom::intersect::{TriTri, tri_tri};
 use crate::geom::predicates::{Sign, in_exact_range, orient3d};
-use crate::geom::vec3::{cross, dot, norm, sub};
+use crate::mesh::coord_key;
 use crate::mesh::surface::SurfaceMesh;
 use crate::mesh::tet::{NO_NEIGHBOR, TET_FACES, TetMesh, sorted3};
+use crate::quality::tri::min_angle_3d_deg;
 use rustc_hash::{FxHashMap, FxHashSet};
 use serde::Serialize;
 use std::collections::VecDeque;
@@ -244,7 +245,7 @@ pub fn recover(
             unrecovered.push(Unrecovered {
                 triangle: s,
                 corners,
-                min_angle_deg: min_angle_deg(&corners),
+                min_angle_deg: min_angle_3d_deg(&corners),
                 reason: r
                     .reason
                     .get(&(s as u32))
@@ -281,11 +282,6 @@ pub fn recover(
         unrecovered,
     };
     Ok(report)
-}
-
-#[inline]
-fn coord_key(p: &P3) -> [u64; 3] {
-    p.map(|c| if c == 0.0 { 0 } else { c.to_bits() })
 }
 
 fn validate_inputs(mesh: &mut TetMesh, surface: &SurfaceMesh) -> Result<(), RecoverError> {
@@ -1162,17 +1158,6 @@ impl<'a> Recovery<'a> {
         self.index();
         before - k
     }
-}
-
-/// Smallest angle of a 3D triangle, in degrees (0 for a degenerate one).
-fn min_angle_deg(c: &[P3; 3]) -> f64 {
-    (0..3)
-        .map(|k| {
-            let (a, b, o) = (c[(k + 1) % 3], c[(k + 2) % 3], c[k]);
-            let (u, v) = (sub(a, o), sub(b, o));
-            norm(cross(u, v)).atan2(dot(u, v)).to_degrees()
-        })
-        .fold(f64::INFINITY, f64::min)
 }
 
 /// Same three vertices in the same cyclic order.

@@ -443,7 +443,7 @@ impl Searcher {
         }
         // Duplicates: sort local ids by coordinates.
         let mut order: Vec<u32> = (0..self.pts.len() as u32).collect();
-        let key = |p: &P3| p.map(|c| if c == 0.0 { 0 } else { c.to_bits() });
+        let key = crate::mesh::coord_key;
         order.sort_unstable_by_key(|&i| key(&self.pts[i as usize]));
         for w in order.windows(2) {
             if key(&self.pts[w[0] as usize]) == key(&self.pts[w[1] as usize]) {

@@ -10,3 +10,10 @@ pub mod surface;
 pub mod tet;
 pub mod tri;
 pub mod validate;
+
+/// The exact identity of a point's coordinates, for matching points across meshes (`-0.0` and
+/// `0.0` are the same point).
+#[inline]
+pub fn coord_key(p: &[f64; 3]) -> [u64; 3] {
+    p.map(|c| if c == 0.0 { 0 } else { c.to_bits() })
+}

@@ -22,6 +22,7 @@
 use rustc_hash::FxHashMap;
 
 use crate::geom::vec3::volume6;
+use crate::mesh::coord_key;
 use crate::mesh::inside::{Location, RegionLocator};
 use crate::mesh::surface::SurfaceMesh;
 
@@ -92,11 +93,6 @@ pub struct Part {
     pub surface: SurfaceMesh,
     /// Labels of its shells in order of first triangle.
     pub labels: Option<Vec<u32>>,
-}
-
-#[inline]
-fn key(p: &[f64; 3]) -> [u64; 3] {
-    p.map(|c| if c == 0.0 { 0 } else { c.to_bits() })
 }
 
 /// Connected components of triangles through shared edges: component of each triangle, count.
@@ -301,7 +297,7 @@ pub fn assemble(parts: Vec<Part>) -> Result<(SurfaceMesh, Vec<Shell>), AssembleE
             .points
             .iter()
             .map(|p| {
-                *index.entry(key(p)).or_insert_with(|| {
+                *index.entry(coord_key(p)).or_insert_with(|| {
                     points.push(*p);
                     (points.len() - 1) as u32
                 })

@@ -1101,7 +1101,7 @@ fn unwelded_points(s: &SurfaceMesh) -> usize {
             used[v as usize] = true;
         }
     }
-    let key = |p: &[f64; 3]| p.map(|c| if c == 0.0 { 0u64 } else { c.to_bits() });
+    let key = super::coord_key;
     let mut keys: Vec<[u64; 3]> = (0..s.points.len())
         .filter(|&i| used[i])
         .map(|i| key(&s.points[i]))

@@ -15,9 +15,11 @@ use rustc_hash::FxHashMap;
 use serde::Serialize;
 
 use crate::geom::vec3::{cross, dot, norm, sub};
+use crate::mesh::coord_key;
 use crate::mesh::surface::SurfaceMesh;
 use crate::mesh::tet::{TET_EDGES, TET_FACES, TetMesh};
 use crate::quality::tet::dihedral_angles;
+use crate::quality::tri::min_angle_3d_deg;
 
 /// Where a tet touches the input surface.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -68,25 +70,9 @@ pub struct ForcingSummary {
 }
 
 #[inline]
-fn key(p: &[f64; 3]) -> [u64; 3] {
-    p.map(|c| if c == 0.0 { 0 } else { c.to_bits() })
-}
-
-#[inline]
 fn sorted3(mut a: [u32; 3]) -> [u32; 3] {
     a.sort_unstable();
     a
-}
-
-/// Smallest angle (degrees) of a triangle.
-fn min_angle_deg(t: [[f64; 3]; 3]) -> f64 {
-    (0..3)
-        .map(|i| {
-            let u = sub(t[(i + 1) % 3], t[i]);
-            let v = sub(t[(i + 2) % 3], t[i]);
-            norm(cross(u, v)).atan2(dot(u, v)).to_degrees()
-        })
-        .fold(f64::INFINITY, f64::min)
 }
 
 /// Classify every tet of `mesh` against `surface` with the angle `threshold_deg`.
@@ -94,19 +80,19 @@ pub fn classify(mesh: &TetMesh, surface: &SurfaceMesh, threshold_deg: f64) -> Fo
     // Mesh point -> surface point.
     let mut index: FxHashMap<[u64; 3], u32> = Default::default();
     for (i, p) in surface.points.iter().enumerate() {
-        index.insert(key(p), i as u32);
+        index.insert(coord_key(p), i as u32);
     }
     let surf_of: Vec<u32> = mesh
         .points
         .iter()
-        .map(|p| index.get(&key(p)).copied().unwrap_or(u32::MAX))
+        .map(|p| index.get(&coord_key(p)).copied().unwrap_or(u32::MAX))
         .collect();
     // Input triangles (sorted surface ids) -> poor?
     let mut triangles: FxHashMap<[u32; 3], bool> = Default::default();
     // Input edges -> (triangle, opposite vertex) per use, for the fold angles.
     let mut edges: FxHashMap<[u32; 2], Vec<(u32, u32)>> = Default::default();
     for (t, tri) in surface.triangles.iter().enumerate() {
-        let poor = min_angle_deg(surface.corners(t)) < threshold_deg;
+        let poor = min_angle_3d_deg(&surface.corners(t)) < threshold_deg;
         triangles.insert(sorted3(*tri), poor);
         for k in 0..3 {
             let (a, b) = (tri[k], tri[(k + 1) % 3]);

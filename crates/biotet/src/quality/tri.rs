@@ -94,3 +94,14 @@ impl TriMeasures {
             .fold(f64::NEG_INFINITY, f64::max)
     }
 }
+
+/// Smallest angle of a triangle in space, in degrees (0 for a degenerate one).
+pub fn min_angle_3d_deg(c: &[[f64; 3]; 3]) -> f64 {
+    use crate::geom::vec3::{cross, dot, norm, sub};
+    (0..3)
+        .map(|k| {
+            let (u, v) = (sub(c[(k + 1) % 3], c[k]), sub(c[(k + 2) % 3], c[k]));
+            norm(cross(u, v)).atan2(dot(u, v)).to_degrees()
+        })
+        .fold(f64::INFINITY, f64::min)
+}

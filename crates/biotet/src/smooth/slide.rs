@@ -58,7 +58,7 @@ pub struct SlideSurface {
 
 #[inline]
 fn key(p: [f64; 3]) -> [u64; 3] {
-    p.map(|c| if c == 0.0 { 0 } else { c.to_bits() })
+    crate::mesh::coord_key(&p)
 }
 
 impl SlideSurface {
