@@ -137,6 +137,25 @@ fn components(tris: &[[u32; 3]]) -> (Vec<u32>, usize) {
     (comp, n as usize)
 }
 
+/// The closed surface `tris` alone, on its own points only (region 1 inside), for locating
+/// points against one shell.
+fn alone(points: &[[f64; 3]], tris: &[[u32; 3]]) -> SurfaceMesh {
+    let mut local: FxHashMap<u32, u32> = Default::default();
+    let mut pts = Vec::new();
+    let tris = tris
+        .iter()
+        .map(|t| {
+            t.map(|v| {
+                *local.entry(v).or_insert_with(|| {
+                    pts.push(points[v as usize]);
+                    (pts.len() - 1) as u32
+                })
+            })
+        })
+        .collect();
+    SurfaceMesh::closed(pts, tris, 1)
+}
+
 /// Whether some edge has more than two triangles.
 fn is_non_manifold(tris: &[[u32; 3]]) -> bool {
     let mut count: FxHashMap<(u32, u32), u32> = Default::default();
@@ -217,9 +236,9 @@ pub fn label_arrangement(
     if !positive.is_empty() && !outer.is_empty() {
         let mut best: Vec<Option<(usize, f64)>> = vec![None; n];
         for &c in &outer {
-            let shell = SurfaceMesh::closed(s.points.clone(), tris_of(c), 1);
-            let on: rustc_hash::FxHashSet<u32> =
-                shell.triangles.iter().flatten().copied().collect();
+            let tris = tris_of(c);
+            let on: rustc_hash::FxHashSet<u32> = tris.iter().flatten().copied().collect();
+            let shell = alone(&s.points, &tris);
             let loc = RegionLocator::new(&shell);
             for &p in &positive {
                 let Some(&v) = half
@@ -379,21 +398,7 @@ pub fn assemble(parts: Vec<Part>) -> Result<(SurfaceMesh, Vec<Shell>), AssembleE
             .map(|tris| tris.iter().flatten().copied().collect())
             .collect();
         for b in 0..n {
-            // Shell b alone, on its own points.
-            let mut local: FxHashMap<u32, u32> = Default::default();
-            let mut pts = Vec::new();
-            let tris: Vec<[u32; 3]> = shell_tris[b]
-                .iter()
-                .map(|t| {
-                    t.map(|v| {
-                        *local.entry(v).or_insert_with(|| {
-                            pts.push(points[v as usize]);
-                            (pts.len() - 1) as u32
-                        })
-                    })
-                })
-                .collect();
-            let sb = SurfaceMesh::closed(pts, tris, 1);
+            let sb = alone(&points, &shell_tris[b]);
             let loc = RegionLocator::new(&sb);
             for a in 0..n {
                 if a == b {
