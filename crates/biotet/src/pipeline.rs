@@ -225,16 +225,15 @@ pub fn mesh_surface(
     if let Some(o) = &opts.recover {
         progress("recovering the boundary");
         let clock = Instant::now();
-        let r = recover(
-            &mut mesh,
-            surface,
-            &RecoverOptions {
-                remove_outside: false,
-                ..*o
-            },
-        )?;
-        report.recover = Some(r);
-        mesh = remove_outside(mesh);
+        report.recover = Some(recover(&mut mesh, surface, o)?);
+        // Recovery drops the outside tets; drop the points only they used.
+        let TetMesh {
+            points,
+            tets,
+            neighbors,
+            labels,
+        } = mesh;
+        mesh = compact(points, tets, neighbors, labels);
         stage(&mut report, "recover", clock);
     }
 
@@ -311,43 +310,6 @@ fn compact(
         neighbors,
         labels,
     }
-}
-
-/// Drop the tets of region 0 and the points only they used.
-fn remove_outside(mesh: TetMesh) -> TetMesh {
-    let TetMesh {
-        points,
-        tets,
-        neighbors,
-        labels,
-    } = mesh;
-    let mut index = vec![NO_NEIGHBOR; tets.len()];
-    let mut n = 0u32;
-    for (t, &l) in labels.iter().enumerate() {
-        if l != 0 {
-            index[t] = n;
-            n += 1;
-        }
-    }
-    if n as usize == tets.len() {
-        return compact(points, tets, neighbors, labels);
-    }
-    let keep = |t: &usize| labels[*t] != 0;
-    let kept_tets: Vec<[u32; 4]> = (0..tets.len()).filter(keep).map(|t| tets[t]).collect();
-    let kept_nb: Vec<[u32; 4]> = (0..tets.len())
-        .filter(keep)
-        .map(|t| {
-            neighbors[t].map(|x| {
-                if x == NO_NEIGHBOR {
-                    x
-                } else {
-                    index[x as usize]
-                }
-            })
-        })
-        .collect();
-    let kept_labels: Vec<u32> = labels.iter().copied().filter(|&l| l != 0).collect();
-    compact(points, kept_tets, kept_nb, kept_labels)
 }
 
 /// Input triangles that are not a face of any tet (matched by point coordinates).
