@@ -190,6 +190,8 @@ struct Work<'a> {
     rounds: Vec<u32>,
     /// Per tet: 0 unknown, 1 forced, 2 not forced.
     forced: Vec<u8>,
+    /// Per tet: its metric and q (NaN until computed).
+    cache: Vec<[f64; 2]>,
     vtet: Vec<u32>,
     free: Vec<u32>,
     searcher: Searcher,
@@ -216,8 +218,20 @@ impl<'a> Work<'a> {
         self.tets[t as usize].map(|v| self.pts[v as usize])
     }
 
-    fn value(&self, t: u32) -> f64 {
-        measure(&self.corners(t), self.opts.metric)
+    /// The metric and q of tet `t`, computed once per tet (a tet's corners never change).
+    fn measures(&mut self, t: u32) -> [f64; 2] {
+        let m = self.cache[t as usize];
+        if !m[0].is_nan() {
+            return m;
+        }
+        let c = self.corners(t);
+        let m = [measure(&c, self.opts.metric), q_measure(&c)];
+        self.cache[t as usize] = m;
+        m
+    }
+
+    fn value(&mut self, t: u32) -> f64 {
+        self.measures(t)[0]
     }
 
     /// Every live tet with corner `v` (walking across the faces around `v`).
@@ -293,16 +307,12 @@ impl<'a> Work<'a> {
         if cav.tets.len() > self.opts.max_cavity_tets {
             return false;
         }
-        let old_worst = cav
-            .tets
-            .iter()
-            .map(|&t| self.value(t))
-            .fold(f64::INFINITY, f64::min);
-        let old_q = cav
-            .tets
-            .iter()
-            .map(|&t| q_measure(&self.corners(t)))
-            .fold(f64::INFINITY, f64::min);
+        let (mut old_worst, mut old_q) = (f64::INFINITY, f64::INFINITY);
+        for &t in &cav.tets {
+            let [m, q] = self.measures(t);
+            old_worst = old_worst.min(m);
+            old_q = old_q.min(q);
+        }
         let so = SearchOptions {
             min_quality: old_q.max(0.0),
             max_nodes: self.opts.max_nodes,
@@ -369,6 +379,7 @@ impl<'a> Work<'a> {
             let t = match self.free.pop() {
                 Some(t) => {
                     self.forced[t as usize] = 0;
+                    self.cache[t as usize] = [f64::NAN; 2];
                     self.tets[t as usize] = *tv;
                     self.nb[t as usize] = [NO_NEIGHBOR; 4];
                     self.labels[t as usize] = label;
@@ -383,6 +394,7 @@ impl<'a> Work<'a> {
                     self.alive.push(true);
                     self.rounds.push(rounds);
                     self.forced.push(0);
+                    self.cache.push([f64::NAN; 2]);
                     (self.tets.len() - 1) as u32
                 }
             };
@@ -554,6 +566,7 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
         alive: Vec::new(),
         rounds: Vec::new(),
         forced: Vec::new(),
+        cache: Vec::new(),
         vtet: vec![NO_NEIGHBOR; mesh.points.len()],
         free: Vec::new(),
         searcher: Searcher::new(),
@@ -572,6 +585,7 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     w.alive = vec![true; n];
     w.rounds = vec![0; n];
     w.forced = vec![0; n];
+    w.cache = vec![[f64::NAN; 2]; n];
     w.report.n_tets_before = n;
     for t in 0..n {
         for &v in &w.tets[t] {
