@@ -259,11 +259,8 @@ pub fn run(a: Args) -> Result<ExitCode> {
                  the surface (the mesh was written for inspection); the first ones:",
                 r.missing_after
             );
-            for u in r.unrecovered.iter().take(10) {
-                eprintln!(
-                    "  triangle {} at {:?}, smallest angle {:.4}°: {}",
-                    u.triangle, u.corners, u.min_angle_deg, u.reason
-                );
+            for line in super::recover::unrecovered_lines(r) {
+                eprintln!("  {line}");
             }
             eprintln!(
                 "  (a size much finer than these triangles makes their cavities large: a size \

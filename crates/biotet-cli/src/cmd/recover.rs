@@ -3,7 +3,7 @@
 
 use crate::{Common, EXIT_INVALID, progress::Stage};
 use anyhow::{Context, Result};
-use biotet::lastresort::{RecoverOptions, recover};
+use biotet::lastresort::{RecoverOptions, RecoverReport, recover};
 use serde_json::json;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -30,6 +30,16 @@ pub struct Args {
     keep_outside: bool,
     #[command(flatten)]
     common: Common,
+}
+
+/// The first ten unrecovered triangles, one line each: index, corners, smallest angle, reason.
+pub fn unrecovered_lines(r: &RecoverReport) -> impl Iterator<Item = String> + '_ {
+    r.unrecovered.iter().take(10).map(|u| {
+        format!(
+            "triangle {} at {:?}, smallest angle {:.4}°: {}",
+            u.triangle, u.corners, u.min_angle_deg, u.reason
+        )
+    })
 }
 
 /// Run `biotet recover`.
@@ -77,11 +87,8 @@ pub fn run(a: Args) -> Result<ExitCode> {
             report.outside_tets_removed,
             report.total_ms / 1e3,
         );
-        for u in report.unrecovered.iter().take(10) {
-            text += &format!(
-                "\n  unrecovered: triangle {} at {:?}, smallest angle {:.4}°: {}",
-                u.triangle, u.corners, u.min_angle_deg, u.reason
-            );
+        for line in unrecovered_lines(&report) {
+            text += &format!("\n  unrecovered: {line}");
         }
         crate::emit(&text);
     }
