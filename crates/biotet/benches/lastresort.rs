@@ -6,37 +6,16 @@
 //! the first run prints the Table 3.1 columns (elements, missing faces, calls, median and
 //! maximum time per call, nodes visited per call).
 
-use biotet::SurfaceMesh;
 use biotet::delaunay::Delaunay;
 use biotet::lastresort::{RecoverOptions, recover};
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
+use std::path::Path;
 use std::time::Duration;
 
-/// Binary STL, exact duplicates welded.
-fn read_stl(name: &str) -> SurfaceMesh {
-    let path = format!("{}/../../tests/data/{name}", env!("CARGO_MANIFEST_DIR"));
-    let bytes = std::fs::read(path).expect("read STL");
-    let n = u32::from_le_bytes(bytes[80..84].try_into().expect("header")) as usize;
-    let f = |o: usize| f32::from_le_bytes(bytes[o..o + 4].try_into().expect("float")) as f64;
-    let mut points = Vec::with_capacity(3 * n);
-    let mut triangles = Vec::with_capacity(n);
-    for t in 0..n {
-        let base = 84 + 50 * t + 12;
-        for c in 0..3 {
-            let o = base + 12 * c;
-            points.push([f(o), f(o + 4), f(o + 8)]);
-        }
-        let i = 3 * t as u32;
-        triangles.push([i, i + 1, i + 2]);
-    }
-    let mut s = SurfaceMesh::closed(points, triangles, 1);
-    s.weld_exact();
-    s
-}
-
 fn bench(c: &mut Criterion) {
-    let s = read_stl("brain_20k.stl");
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/brain_20k.stl");
+    let s = biotet_io::read_surface(&path).expect("brain_20k.stl").mesh;
     let mesh = Delaunay::new(&s.points).expect("Delaunay").to_tet_mesh();
     let opts = RecoverOptions::default();
     {

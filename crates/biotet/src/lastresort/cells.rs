@@ -34,7 +34,9 @@ pub(crate) struct Cells {
     wings: Vec<Wing>,
     parent: Vec<u32>,
     group: Vec<Wing>,
-    class: Vec<u8>,
+    /// The wings of `group` with their angle class, for sorting.
+    classed: Vec<(u8, Wing)>,
+    root_cell: Vec<u32>,
 }
 
 fn find(parent: &mut [u32], mut x: u32) -> u32 {
@@ -107,7 +109,9 @@ impl Cells {
             i = j;
         }
         cell.clear();
-        let mut root_cell: Vec<u32> = vec![u32::MAX; faces.len()];
+        let root_cell = &mut self.root_cell;
+        root_cell.clear();
+        root_cell.resize(faces.len(), u32::MAX);
         let mut n = 0;
         for f in 0..faces.len() {
             let r = find(&mut self.parent, f as u32) as usize;
@@ -132,7 +136,7 @@ impl Cells {
         let (a2, b2) = (drop_axis(a, axis), drop_axis(b, axis));
         let s0 = orient2d(a2, b2, drop_axis(c0, axis));
         // Class: 0 = the reference half-plane, 1 = angle in (0, π), 2 = π, 3 = (π, 2π).
-        self.class.clear();
+        self.classed.clear();
         for w in &self.group {
             let c = points[w.apex as usize];
             let cl = match orient3d(a, b, c0, c) {
@@ -146,17 +150,12 @@ impl Cells {
                     if s == s0 { 0 } else { 2 }
                 }
             };
-            self.class.push(cl);
+            self.classed.push((cl, *w));
         }
-        let mut idx: Vec<usize> = (0..self.group.len()).collect();
-        let group = &self.group;
-        let class = &self.class;
-        idx.sort_by(|&x, &y| {
-            let (cx, cy) = (class[x], class[y]);
+        self.classed.sort_by(|&(cx, wx), &(cy, wy)| {
             if cx != cy {
                 return cx.cmp(&cy);
             }
-            let (wx, wy) = (group[x], group[y]);
             let ang = if cx == 1 || cx == 3 {
                 match orient3d(a, b, points[wx.apex as usize], points[wy.apex as usize]) {
                     Sign::Positive => Ordering::Less,
@@ -170,8 +169,8 @@ impl Cells {
             ang.then(wx.forward.cmp(&wy.forward))
                 .then(wx.face.cmp(&wy.face))
         });
-        let sorted: Vec<Wing> = idx.iter().map(|&k| self.group[k]).collect();
-        self.group = sorted;
+        self.group.clear();
+        self.group.extend(self.classed.iter().map(|&(_, w)| w));
         Ok(())
     }
 }

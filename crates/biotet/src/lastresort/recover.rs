@@ -48,7 +48,7 @@
 //! exhausts its node budget costs up to a few hundred ms.
 
 use super::cells::Cells;
-use super::search::{SearchError, SearchOptions, Searcher};
+use super::search::{SearchError, SearchOptions, Searcher, bbox};
 use crate::delaunay::Delaunay;
 use crate::geom::intersect::{TriTri, tri_tri};
 use crate::geom::predicates::{Sign, in_exact_range, orient3d};
@@ -491,6 +491,12 @@ impl<'a> Recovery<'a> {
             .count()
     }
 
+    /// The missing triangles whose corners are all mesh points.
+    fn missing_mapped(&self) -> impl Iterator<Item = u32> + '_ {
+        (0..self.tri_map.len() as u32)
+            .filter(|&s| self.tri_map[s as usize].is_some_and(|v| !self.present(v)))
+    }
+
     /// Make the mesh cover the convex hull of its points (module docs, step 1).
     fn cover(&mut self) -> Result<Domain, RecoverError> {
         if boundary_is_convex(self.mesh) {
@@ -534,9 +540,7 @@ impl<'a> Recovery<'a> {
 
     /// Process the queue of missing triangles (module docs, steps 3–4).
     fn run(&mut self) {
-        let mut queue: VecDeque<u32> = (0..self.tri_map.len() as u32)
-            .filter(|&s| self.tri_map[s as usize].is_some_and(|v| !self.present(v)))
-            .collect();
+        let mut queue: VecDeque<u32> = self.missing_mapped().collect();
         let mut stalled = 0usize;
         while let Some(s) = queue.pop_front() {
             let Some(v) = self.tri_map[s as usize] else {
@@ -771,13 +775,7 @@ impl<'a> Recovery<'a> {
     /// convex hull, split differently) is [`Place::OnBoundary`]: those faces are replaced by it.
     fn inside_cavity(&self, v: [u32; 3], cav: &Cavity, st: u32) -> Place {
         let tp = v.map(|x| self.mesh.points[x as usize]);
-        let (mut lo, mut hi) = (tp[0], tp[0]);
-        for p in &tp[1..] {
-            for k in 0..3 {
-                lo[k] = lo[k].min(p[k]);
-                hi[k] = hi[k].max(p[k]);
-            }
-        }
+        let (lo, hi) = bbox(&tp);
         let mut on_boundary = Vec::new();
         for (i, (g, n, _)) in cav.shell.iter().enumerate() {
             let gp = g.map(|x| self.mesh.points[x as usize]);
@@ -875,9 +873,7 @@ impl<'a> Recovery<'a> {
                 };
                 match self.searcher.fill(&cav.coords, &faces, &inner, &o) {
                     Ok(f) => first = Some(f),
-                    Err(SearchError::NoFill { nodes_visited })
-                    | Err(SearchError::Budget { nodes_visited }) => *nodes += nodes_visited,
-                    Err(_) => {}
+                    Err(e) => *nodes += nodes_of(&e),
                 }
             }
             let result = match first {
@@ -892,11 +888,7 @@ impl<'a> Recovery<'a> {
                     out.extend(f.tets.iter().map(|t| t.map(|x| cav.points[x as usize])));
                 }
                 Err(e) => {
-                    if let SearchError::NoFill { nodes_visited }
-                    | SearchError::Budget { nodes_visited } = e
-                    {
-                        *nodes += nodes_visited;
-                    }
+                    *nodes += nodes_of(&e);
                     return Err(Failure::Search(e));
                 }
             }
@@ -1025,9 +1017,7 @@ impl<'a> Recovery<'a> {
 
     /// Last resort: the failed triangles again, each cavity with one interior point.
     fn run_steiner(&mut self) {
-        let todo: Vec<u32> = (0..self.tri_map.len() as u32)
-            .filter(|&s| self.tri_map[s as usize].is_some_and(|v| !self.present(v)))
-            .collect();
+        let todo: Vec<u32> = self.missing_mapped().collect();
         for s in todo {
             let Some(v) = self.tri_map[s as usize] else {
                 continue;
@@ -1060,9 +1050,16 @@ impl<'a> Recovery<'a> {
 
     /// Drop dead slots and rebuild adjacency.
     fn compact(&mut self) {
+        self.retain_tets(|r, t| r.alive[t]);
+    }
+
+    /// Keep the tets for which `keep` holds (in order), rebuild adjacency and incidences;
+    /// returns how many were removed.
+    fn retain_tets(&mut self, keep: impl Fn(&Self, usize) -> bool) -> usize {
+        let before = self.mesh.tets.len();
         let mut k = 0;
-        for t in 0..self.mesh.tets.len() {
-            if self.alive[t] {
+        for t in 0..before {
+            if keep(self, t) {
                 self.mesh.tets[k] = self.mesh.tets[t];
                 self.mesh.labels[k] = self.mesh.labels[t];
                 k += 1;
@@ -1072,6 +1069,7 @@ impl<'a> Recovery<'a> {
         self.mesh.labels.truncate(k);
         self.mesh.rebuild_neighbors();
         self.index();
+        before - k
     }
 
     /// Flood-fill region labels from the surface's side labels and remove region 0. Returns
@@ -1143,20 +1141,17 @@ impl<'a> Recovery<'a> {
 
     /// Remove the tets labelled 0.
     fn remove_outside(&mut self) -> usize {
-        let before = self.mesh.tets.len();
-        let mut k = 0;
-        for t in 0..before {
-            if self.mesh.labels[t] != 0 {
-                self.mesh.tets[k] = self.mesh.tets[t];
-                self.mesh.labels[k] = self.mesh.labels[t];
-                k += 1;
-            }
+        self.retain_tets(|r, t| r.mesh.labels[t] != 0)
+    }
+}
+
+/// Search nodes a failed search visited (none for an input error).
+fn nodes_of(e: &SearchError) -> u64 {
+    match *e {
+        SearchError::NoFill { nodes_visited } | SearchError::Budget { nodes_visited } => {
+            nodes_visited
         }
-        self.mesh.tets.truncate(k);
-        self.mesh.labels.truncate(k);
-        self.mesh.rebuild_neighbors();
-        self.index();
-        before - k
+        _ => 0,
     }
 }
 

@@ -239,6 +239,8 @@ pub struct Searcher {
     improve: Option<u64>,
     scratch: Vec<[u32; 3]>,
     edges: Vec<(u32, u32)>,
+    /// Local point ids sorted by coordinates (the duplicate check).
+    order: Vec<u32>,
     /// Rows of `orient`: one per triangle met (sorted corners), for the whole call: the points
     /// never move, so an orientation once computed holds for every face, candidate and level.
     rows: FxHashMap<[u32; 3], u32>,
@@ -318,21 +320,9 @@ fn same_set(a: [u32; 3], b: [u32; 3]) -> bool {
     a.iter().all(|x| b.contains(x))
 }
 
+/// Bounding box of a triangle's or a tet's corners.
 #[inline]
-fn bbox4(c: &[P3; 4]) -> (P3, P3) {
-    let mut lo = c[0];
-    let mut hi = c[0];
-    for p in &c[1..] {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    (lo, hi)
-}
-
-#[inline]
-fn bbox3(c: &[P3; 3]) -> (P3, P3) {
+pub(super) fn bbox<const N: usize>(c: &[P3; N]) -> (P3, P3) {
     let mut lo = c[0];
     let mut hi = c[0];
     for p in &c[1..] {
@@ -442,10 +432,12 @@ impl Searcher {
             self.pts.push(p);
         }
         // Duplicates: sort local ids by coordinates.
-        let mut order: Vec<u32> = (0..self.pts.len() as u32).collect();
+        let order = &mut self.order;
+        order.clear();
+        order.extend(0..self.pts.len() as u32);
         let key = crate::mesh::coord_key;
         order.sort_unstable_by_key(|&i| key(&self.pts[i as usize]));
-        for w in order.windows(2) {
+        for w in self.order.windows(2) {
             if key(&self.pts[w[0] as usize]) == key(&self.pts[w[1] as usize]) {
                 return Err(SearchError::DuplicatePoint {
                     a: self.global[w[0] as usize],
@@ -518,7 +510,7 @@ impl Searcher {
         let id = self.faces.len() as u32;
         let c = self.cands.len() as u32;
         let plane = self.plane(v);
-        let (lo, hi) = bbox3(&v.map(|x| self.pts[x as usize]));
+        let (lo, hi) = bbox(&v.map(|x| self.pts[x as usize]));
         self.front_pos.push(self.front.len() as u32);
         self.front.push(id);
         self.front_box.push((lo, hi));
@@ -780,7 +772,7 @@ impl Searcher {
             {
                 continue;
             }
-            let (lo, hi) = bbox4(&corners);
+            let (lo, hi) = bbox(&corners);
             self.cands.push(Cand {
                 p,
                 q,

@@ -126,6 +126,18 @@ pub fn load_stl(name: &str) -> SurfaceMesh {
     s
 }
 
+/// `n` SplitMix64 points in the unit cube [0, 1)^3, reproducible from `seed`.
+pub fn random_points(n: usize, mut seed: u64) -> Vec<[f64; 3]> {
+    let mut next = move || {
+        seed = seed.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = seed;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    (0..n).map(|_| [next(), next(), next()]).collect()
+}
+
 /// The octahedron |x| + |y| + |z| = r, outward, sides [1, 0].
 pub fn octahedron(r: f64) -> SurfaceMesh {
     let p = vec![

@@ -126,26 +126,10 @@ fn search_fills_cube_with_inner_point() {
 
 #[test]
 fn search_fills_octahedron() {
-    let pts: Vec<P3> = vec![
-        [1.0, 0.0, 0.0],
-        [-1.0, 0.0, 0.0],
-        [0.0, 1.0, 0.0],
-        [0.0, -1.0, 0.0],
-        [0.0, 0.0, 1.0],
-        [0.0, 0.0, -1.0],
-    ];
-    // Outward faces, then reversed to point inwards.
-    let out = [
-        [0, 2, 4],
-        [2, 1, 4],
-        [1, 3, 4],
-        [3, 0, 4],
-        [2, 0, 5],
-        [1, 2, 5],
-        [3, 1, 5],
-        [0, 3, 5],
-    ];
-    let shell: Vec<[u32; 3]> = out.iter().map(|f| [f[0], f[2], f[1]]).collect();
+    // Outward faces, reversed to point inwards.
+    let s = crate::common::octahedron(1.0);
+    let pts = s.points;
+    let shell: Vec<[u32; 3]> = s.triangles.iter().map(|f| [f[0], f[2], f[1]]).collect();
     let f = fill(&pts, &shell, &[], &SearchOptions::default()).unwrap();
     assert_fills(&pts, &shell, &[], &f.tets);
     assert_eq!(f.tets.len(), 4);
@@ -269,24 +253,12 @@ fn search_rejects_bad_input() {
     ));
 }
 
-/// SplitMix64 points in the unit cube.
-fn random_points(n: usize, mut seed: u64) -> Vec<P3> {
-    let mut next = move || {
-        seed = seed.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = seed;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    };
-    (0..n).map(|_| [next(), next(), next()]).collect()
-}
-
 #[test]
 fn search_refills_delaunay_cavities() {
     // Carve the tets around a few vertices of a random Delaunay mesh and fill the cavity again:
     // a fill exists (the carved tets), the search must find one.
     use biotet::delaunay::Delaunay;
-    let pts = random_points(2000, 7);
+    let pts = crate::common::random_points(2000, 7);
     let mesh = Delaunay::new(&pts).unwrap().to_tet_mesh();
     let mut total_nodes = 0;
     let mut calls = 0;
@@ -334,29 +306,6 @@ use biotet::delaunay::Delaunay;
 use biotet::geom::intersect::{SegTri, seg_tri};
 use biotet::lastresort::{RecoverOptions, recover};
 use biotet::{SurfaceMesh, TetMesh};
-
-/// A tiny binary-STL reader (biotet cannot depend on biotet-io), exact duplicates welded.
-fn read_stl(name: &str) -> SurfaceMesh {
-    let path = format!("{}/../../tests/data/{name}", env!("CARGO_MANIFEST_DIR"));
-    let bytes = std::fs::read(path).expect("read STL");
-    let n = u32::from_le_bytes(bytes[80..84].try_into().unwrap()) as usize;
-    assert_eq!(bytes.len(), 84 + 50 * n, "binary STL size");
-    let f = |o: usize| f32::from_le_bytes(bytes[o..o + 4].try_into().unwrap()) as f64;
-    let mut points = Vec::with_capacity(3 * n);
-    let mut triangles = Vec::with_capacity(n);
-    for t in 0..n {
-        let base = 84 + 50 * t + 12;
-        for c in 0..3 {
-            let o = base + 12 * c;
-            points.push([f(o), f(o + 4), f(o + 8)]);
-        }
-        let i = 3 * t as u32;
-        triangles.push([i, i + 1, i + 2]);
-    }
-    let mut s = SurfaceMesh::closed(points, triangles, 1);
-    s.weld_exact();
-    s
-}
 
 /// Volume enclosed by a closed outward surface.
 fn enclosed_volume(s: &SurfaceMesh) -> f64 {
@@ -510,21 +459,21 @@ fn recover_and_check(name: &str, s: &SurfaceMesh, mut m: TetMesh, opts: &Recover
 
 #[test]
 fn recover_brain_delaunay_trimmed() {
-    let s = read_stl("brain_20k.stl");
+    let s = crate::common::load_stl("brain_20k.stl");
     let m = delaunay_trimmed(&s);
     recover_and_check("brain_20k trimmed", &s, m, &RecoverOptions::default());
 }
 
 #[test]
 fn recover_brain_delaunay_hull() {
-    let s = read_stl("brain_20k.stl");
+    let s = crate::common::load_stl("brain_20k.stl");
     let m = Delaunay::new(&s.points).unwrap().to_tet_mesh();
     recover_and_check("brain_20k hull", &s, m, &RecoverOptions::default());
 }
 
 #[test]
 fn recover_white_matter_delaunay_trimmed() {
-    let s = read_stl("wm_20k.stl");
+    let s = crate::common::load_stl("wm_20k.stl");
     let m = delaunay_trimmed(&s);
     recover_and_check("wm_20k trimmed", &s, m, &RecoverOptions::default());
 }
@@ -572,25 +521,7 @@ fn recover_unit_shells() {
     let (p, f) = twisted_prism(30.0, true);
     recover_small(&surface_of(&p, &f), &[]);
     // The octahedron with points inside.
-    let pts: Vec<P3> = vec![
-        [1.0, 0.0, 0.0],
-        [-1.0, 0.0, 0.0],
-        [0.0, 1.0, 0.0],
-        [0.0, -1.0, 0.0],
-        [0.0, 0.0, 1.0],
-        [0.0, 0.0, -1.0],
-    ];
-    let out = [
-        [0, 2, 4],
-        [2, 1, 4],
-        [1, 3, 4],
-        [3, 0, 4],
-        [2, 0, 5],
-        [1, 2, 5],
-        [3, 1, 5],
-        [0, 3, 5],
-    ];
-    let s = SurfaceMesh::closed(pts, out.to_vec(), 1);
+    let s = crate::common::octahedron(1.0);
     recover_small(&s, &[[0.1, 0.2, 0.05], [-0.2, 0.1, -0.3]]);
 }
 
