@@ -428,8 +428,9 @@ pub fn smooth(
             if let Some(l) = m.loc {
                 kind[v] = Kind::Motion(Motion::Slide(l));
             }
-            for &t in s {
-                tet_min[t as usize] = min4(solid_angles(&mesh.corners(t as usize)));
+            // The cluster has the star's angles at the new position already.
+            for (&t, m) in s.iter().zip(cluster.tet_minima()) {
+                tet_min[t as usize] = m;
                 for &u in &mesh.tets[t as usize] {
                     touched[u as usize] = true;
                 }
