@@ -14,36 +14,14 @@ MMG's process wall time; TetGen's `tetrahedralize` call. Quality comes from one 
 `biotet quality --json` (min solid angle, min/max dihedral, tets under 10°, share of solid angles under 0.2 sr).
 Set BIOTET to the binary if it is not target/release/biotet.
 """
-import argparse, json, os, shutil, statistics, subprocess, sys, tempfile, textwrap, time
+import argparse, json, os, shutil, statistics, subprocess, sys, tempfile, time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BIOTET = os.environ.get("BIOTET", os.path.join(ROOT, "target", "release", "biotet"))
 DEFAULT = os.path.join(ROOT, "tests", "data", "brain_20k.stl")
 
-PIP_TETGEN = textwrap.dedent(r'''
-    import json, sys, time
-    import numpy as np, meshio, tetgen
-    surface, switches, out = sys.argv[1], sys.argv[2], sys.argv[3]
-    m = meshio.read(surface)
-    p = np.asarray(m.points, dtype=float)
-    t = np.asarray(m.cells_dict["triangle"], dtype=np.int32)
-    p, inv = np.unique(p, axis=0, return_inverse=True)
-    t = inv.reshape(-1)[t]
-    g = tetgen.TetGen(p, t)
-    start = time.perf_counter()
-    res = g.tetrahedralize(switches=switches)
-    seconds = time.perf_counter() - start
-    nodes, elems = res[0], res[1]
-    with open(out + ".node", "w") as f:
-        f.write(f"{len(nodes)} 3 0 0\n")
-        for i, q in enumerate(nodes):
-            f.write(f"{i} {float(q[0])!r} {float(q[1])!r} {float(q[2])!r}\n")
-    with open(out + ".ele", "w") as f:
-        f.write(f"{len(elems)} 4 0\n")
-        for i, e in enumerate(elems):
-            f.write(f"{i} {e[0]} {e[1]} {e[2]} {e[3]}\n")
-    print(json.dumps({"seconds": seconds}))
-''')
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from bench_mesh import PIP_TETGEN  # noqa: E402  (the pip TetGen child: meshes, writes .node/.ele, prints its seconds)
 
 
 def mmg3d():

@@ -22,6 +22,7 @@ use std::path::Path;
 use anyhow::Result;
 use biotet::quality::{Histogram, QualityReport, REGULAR_SOLID_ANGLE, TriQualityReport};
 use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 /// Size of the whole picture, in pixels.
@@ -83,10 +84,7 @@ pub fn write_quality_svg(report: &QualityReport, path: &Path, title: &str) -> Re
     };
 
     let h = &r.solid_angle_histogram;
-    // Show up to the last non-empty bin (at least 1 sr, in whole 0.5 sr steps): solid angles
-    // above ~2 sr are rare and the full [0, 6.3] range would squeeze the bulk into a corner.
-    let last = h.occupied().map_or(0.0, |o| h.bin_hi(*o.end()));
-    let x_hi = (last.max(1.0) * 2.0).ceil() / 2.0;
+    let x_hi = solid_x_hi(&[h]);
     let mut notes = vec![format!(
         "min {}  max {}  mean {}",
         sr(r.min_solid_angle_sr),
@@ -117,7 +115,7 @@ pub fn write_quality_svg(report: &QualityReport, path: &Path, title: &str) -> Re
         )],
         notes,
     };
-    write_svg(path, title, [&dihedral, &solid])
+    write_svg(path, title, [&dihedral, &solid], draw_panel)
 }
 
 /// Draw the angle and minimum-angle histograms of a 2D triangle mesh's report to an SVG file at
@@ -166,7 +164,7 @@ pub fn write_tri_quality_svg(report: &TriQualityReport, path: &Path, title: &str
             ),
         ],
     };
-    write_svg(path, title, [&angles, &min_angles])
+    write_svg(path, title, [&angles, &min_angles], draw_panel)
 }
 
 /// Draw the dihedral- and solid-angle histograms of a mesh before and after smoothing, overlaid
@@ -208,11 +206,7 @@ pub fn write_smooth_svg(
     };
     let hb = &before.solid_angle_histogram;
     let ha = &after.solid_angle_histogram;
-    let last = [hb, ha]
-        .iter()
-        .filter_map(|h| h.occupied().map(|o| h.bin_hi(*o.end())))
-        .fold(0.0, f64::max);
-    let x_hi = (last.max(1.0) * 2.0).ceil() / 2.0;
+    let x_hi = solid_x_hi(&[hb, ha]);
     let solid = Overlay {
         caption: "Solid angles before and after (0.05 sr bins)".into(),
         x_desc: "solid angle (steradians)",
@@ -237,21 +231,7 @@ pub fn write_smooth_svg(
             ),
         ],
     };
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
-        root.fill(&WHITE)?;
-        let root = root.titled(title, (FONT, 24).into_font().color(&BLACK))?;
-        let (left, right) = root.split_horizontally(SIZE.0 / 2);
-        draw_overlay(&left, &dihedral)?;
-        draw_overlay(&right, &solid)?;
-        root.present()?;
-    }
-    biotet_io::atomic::write_atomic(path, |w| {
-        w.write_all(svg.as_bytes())
-            .map_err(|e| biotet_io::Error::io(&path.display().to_string(), e))
-    })?;
-    Ok(())
+    write_svg(path, title, [&dihedral, &solid], draw_overlay)
 }
 
 /// One panel of [`write_smooth_svg`]: two histograms with the same bins.
@@ -266,21 +246,8 @@ struct Overlay<'a> {
     notes: Vec<String>,
 }
 
-fn draw_overlay(area: &DrawingArea<SVGBackend, Shift>, p: &Overlay) -> Result<()> {
-    let line = 16;
-    let (head, body) = area.split_vertically(34 + line * p.notes.len() as i32);
-    head.draw(&Text::new(
-        p.caption.clone(),
-        (68, 8),
-        (FONT, 18).into_font().color(&BLACK),
-    ))?;
-    for (i, note) in p.notes.iter().enumerate() {
-        head.draw(&Text::new(
-            note.clone(),
-            (68, 32 + line * i as i32),
-            (FONT, 13).into_font().color(&BLACK.mix(0.85)),
-        ))?;
-    }
+fn draw_overlay(area: &Area, p: &Overlay) -> Result<()> {
+    let body = draw_head(area, &p.caption, &p.notes)?;
     let (x0, x1) = p.x_range;
     let peak = [p.before, p.after]
         .iter()
@@ -289,53 +256,14 @@ fn draw_overlay(area: &DrawingArea<SVGBackend, Shift>, p: &Overlay) -> Result<()
         .unwrap_or(0)
         .max(1) as f64;
     let y_hi = peak * 1000.0;
-    let mut chart = ChartBuilder::on(&body)
-        .margin(12)
-        .margin_top(4)
-        .x_label_area_size(44)
-        .y_label_area_size(56)
-        .build_cartesian_2d(x0..x1, (FLOOR..y_hi).log_scale())?;
-    let n_x_labels = ((x1 - x0) / p.x_step).round() as usize + 1;
+    let mut chart = log_chart(&body, p.x_range, p.x_step, p.x_desc, y_hi)?;
     chart
-        .configure_mesh()
-        .disable_x_mesh()
-        .x_labels(n_x_labels)
-        .y_labels(12)
-        .x_label_formatter(&|x| {
-            let s = format!("{x:.2}");
-            s.trim_end_matches('0').trim_end_matches('.').to_string()
-        })
-        .y_label_formatter(&|y| count_label(*y))
-        .x_desc(p.x_desc)
-        .y_desc("count (log scale)")
-        .label_style((FONT, 13))
-        .axis_desc_style((FONT, 14))
-        .light_line_style(WHITE)
-        .bold_line_style(BLACK.mix(0.12))
-        .draw()?;
-    let bars = |h: &Histogram| -> Vec<[(f64, f64); 2]> {
-        (0..h.counts.len())
-            .filter_map(|i| {
-                let (lo, hi, c) = (h.bin_lo(i), h.bin_hi(i), h.counts[i]);
-                (c > 0 && lo < x1).then_some([(lo, FLOOR), (hi.min(x1), c as f64)])
-            })
-            .collect()
-    };
-    chart
-        .draw_series(
-            bars(p.after)
-                .into_iter()
-                .map(|r| Rectangle::new(r, BAR.mix(0.6).filled())),
-        )?
+        .draw_series(bars(p.after, x1).map(|r| Rectangle::new(r, BAR.mix(0.6).filled())))?
         .label(format!("after ({} values)", p.after.total()))
         .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], BAR.mix(0.6).filled()));
     let grey = RGBColor(60, 60, 60);
     chart
-        .draw_series(
-            bars(p.before)
-                .into_iter()
-                .map(|r| Rectangle::new(r, grey.stroke_width(2))),
-        )?
+        .draw_series(bars(p.before, x1).map(|r| Rectangle::new(r, grey.stroke_width(2))))?
         .label(format!("before ({} values)", p.before.total()))
         .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], grey.stroke_width(2)));
     let (rx, rl) = (&p.reference.0, &p.reference.1);
@@ -350,14 +278,7 @@ fn draw_overlay(area: &DrawingArea<SVGBackend, Shift>, p: &Overlay) -> Result<()
             .label(rl.clone())
             .legend(|(x, y)| PathElement::new([(x, y), (x + 14, y)], REFERENCE.stroke_width(2)));
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .label_font((FONT, 12))
-        .background_style(WHITE)
-        .border_style(BLACK.mix(0.4))
-        .draw()?;
-    Ok(())
+    draw_legend(&mut chart)
 }
 
 /// `x` with `prec` decimals, more for a small value (three significant digits), scientific
@@ -424,49 +345,63 @@ fn count_label(y: f64) -> String {
     }
 }
 
-/// Render the panels into an SVG string.
-fn render(title: &str, panels: [&Panel; 2]) -> Result<String> {
+/// One half of the picture.
+type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
+
+/// A chart with a linear x axis and a log count axis.
+type LogChart<'a, 'b> =
+    ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, LogCoord<f64>>>;
+
+/// Render two panels side by side under `title` into an SVG string, each with `draw`.
+fn render<P>(title: &str, panels: [&P; 2], draw: fn(&Area, &P) -> Result<()>) -> Result<String> {
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
         root.fill(&WHITE)?;
         let root = root.titled(title, (FONT, 24).into_font().color(&BLACK))?;
         let (left, right) = root.split_horizontally(SIZE.0 / 2);
-        draw_panel(&left, panels[0])?;
-        draw_panel(&right, panels[1])?;
+        draw(&left, panels[0])?;
+        draw(&right, panels[1])?;
         root.present()?;
     }
     Ok(svg)
 }
 
-fn draw_panel(area: &DrawingArea<SVGBackend, Shift>, p: &Panel) -> Result<()> {
-    // The caption and the notes above the plot, the plot below.
+/// Draw `caption` and the `notes` at the top of `area`; the rest of it, for the plot.
+fn draw_head<'a>(area: &Area<'a>, caption: &str, notes: &[String]) -> Result<Area<'a>> {
     let line = 16;
-    let (head, body) = area.split_vertically(34 + line * p.notes.len() as i32);
+    let (head, body) = area.split_vertically(34 + line * notes.len() as i32);
     head.draw(&Text::new(
-        p.caption.clone(),
+        caption.to_string(),
         (68, 8),
         (FONT, 18).into_font().color(&BLACK),
     ))?;
-    for (i, note) in p.notes.iter().enumerate() {
+    for (i, note) in notes.iter().enumerate() {
         head.draw(&Text::new(
             note.clone(),
             (68, 32 + line * i as i32),
             (FONT, 13).into_font().color(&BLACK.mix(0.85)),
         ))?;
     }
+    Ok(body)
+}
 
-    let (x0, x1) = p.x_range;
-    let peak = p.hist.counts.iter().copied().max().unwrap_or(0).max(1) as f64;
-    // Three decades of headroom above the tallest bar for the mark labels and the legend.
-    let y_hi = peak * 1000.0;
-    let mut chart = ChartBuilder::on(&body)
+/// The chart of a histogram panel on `body`: `x_range` labelled every `x_step`, counts on a log
+/// axis from [`FLOOR`] to `y_hi`, axes and grid drawn.
+fn log_chart<'a, 'b>(
+    body: &'a Area<'b>,
+    (x0, x1): (f64, f64),
+    x_step: f64,
+    x_desc: &str,
+    y_hi: f64,
+) -> Result<LogChart<'a, 'b>> {
+    let mut chart = ChartBuilder::on(body)
         .margin(12)
         .margin_top(4)
         .x_label_area_size(44)
         .y_label_area_size(56)
         .build_cartesian_2d(x0..x1, (FLOOR..y_hi).log_scale())?;
-    let n_x_labels = ((x1 - x0) / p.x_step).round() as usize + 1;
+    let n_x_labels = ((x1 - x0) / x_step).round() as usize + 1;
     chart
         .configure_mesh()
         .disable_x_mesh()
@@ -477,32 +412,61 @@ fn draw_panel(area: &DrawingArea<SVGBackend, Shift>, p: &Panel) -> Result<()> {
             s.trim_end_matches('0').trim_end_matches('.').to_string()
         })
         .y_label_formatter(&|y| count_label(*y))
-        .x_desc(p.x_desc)
+        .x_desc(x_desc)
         .y_desc("count (log scale)")
         .label_style((FONT, 13))
         .axis_desc_style((FONT, 14))
         .light_line_style(WHITE)
         .bold_line_style(BLACK.mix(0.12))
         .draw()?;
+    Ok(chart)
+}
 
-    let h = p.hist;
-    let shown = |i: usize| {
+/// The bars of the non-empty bins of `h` starting below `x1` (cut at `x1`), from [`FLOOR`] up.
+fn bars(h: &Histogram, x1: f64) -> impl Iterator<Item = [(f64, f64); 2]> + '_ {
+    (0..h.counts.len()).filter_map(move |i| {
         let (lo, hi, c) = (h.bin_lo(i), h.bin_hi(i), h.counts[i]);
         (c > 0 && lo < x1).then_some([(lo, FLOOR), (hi.min(x1), c as f64)])
-    };
+    })
+}
+
+/// The legend box in the upper right corner.
+fn draw_legend<'a, 'b: 'a>(chart: &mut LogChart<'a, 'b>) -> Result<()> {
     chart
-        .draw_series(
-            (0..h.counts.len())
-                .filter_map(shown)
-                .map(|r| Rectangle::new(r, BAR.mix(0.75).filled())),
-        )?
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .label_font((FONT, 12))
+        .background_style(WHITE)
+        .border_style(BLACK.mix(0.4))
+        .draw()?;
+    Ok(())
+}
+
+/// The upper end of a solid-angle axis for histograms `hs` (same bins): up to the last non-empty
+/// bin, at least 1 sr, in whole 0.5 sr steps. Solid angles above ~2 sr are rare and the full
+/// [0, 6.3] range would squeeze the bulk into a corner.
+fn solid_x_hi(hs: &[&Histogram]) -> f64 {
+    let last = hs
+        .iter()
+        .filter_map(|h| h.occupied().map(|o| h.bin_hi(*o.end())))
+        .fold(0.0, f64::max);
+    (last.max(1.0) * 2.0).ceil() / 2.0
+}
+
+fn draw_panel(area: &Area, p: &Panel) -> Result<()> {
+    let body = draw_head(area, &p.caption, &p.notes)?;
+    let (x0, x1) = p.x_range;
+    let peak = p.hist.counts.iter().copied().max().unwrap_or(0).max(1) as f64;
+    // Three decades of headroom above the tallest bar for the mark labels and the legend.
+    let y_hi = peak * 1000.0;
+    let mut chart = log_chart(&body, p.x_range, p.x_step, p.x_desc, y_hi)?;
+
+    let h = p.hist;
+    chart
+        .draw_series(bars(h, x1).map(|r| Rectangle::new(r, BAR.mix(0.75).filled())))?
         .label(format!("count ({} values)", h.total()))
         .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], BAR.mix(0.75).filled()));
-    chart.draw_series(
-        (0..h.counts.len())
-            .filter_map(shown)
-            .map(|r| Rectangle::new(r, BAR.stroke_width(1))),
-    )?;
+    chart.draw_series(bars(h, x1).map(|r| Rectangle::new(r, BAR.stroke_width(1))))?;
 
     // Threshold and reference lines, labelled a little above the tallest bar.
     for (x, label, color) in &p.marks {
@@ -531,20 +495,18 @@ fn draw_panel(area: &DrawingArea<SVGBackend, Shift>, p: &Panel) -> Result<()> {
             .label(label)
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 14, y)], c.stroke_width(2)));
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .label_font((FONT, 12))
-        .background_style(WHITE)
-        .border_style(BLACK.mix(0.4))
-        .draw()?;
-    Ok(())
+    draw_legend(&mut chart)
 }
 
 /// Render, then write through a temporary file in the target's directory and rename it into
 /// place, so the target is either the old file or the whole new one.
-fn write_svg(path: &Path, title: &str, panels: [&Panel; 2]) -> Result<()> {
-    let svg = render(title, panels)?;
+fn write_svg<P>(
+    path: &Path,
+    title: &str,
+    panels: [&P; 2],
+    draw: fn(&Area, &P) -> Result<()>,
+) -> Result<()> {
+    let svg = render(title, panels, draw)?;
     biotet_io::atomic::write_atomic(path, |w| {
         w.write_all(svg.as_bytes())
             .map_err(|e| biotet_io::Error::io(&path.display().to_string(), e))

@@ -26,7 +26,11 @@ const OTHERS: [[usize; 3]; 4] = [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]];
 /// [`crate::quality::tet::solid_angles`]) and the gradient of each with respect to the position
 /// of corner `k` (`0..4`).
 pub fn solid_angle_gradients(c: &[[f64; 3]; 4], k: usize) -> ([f64; 4], [[f64; 3]; 4]) {
-    let omega = solid_angles(c);
+    (solid_angles(c), gradients(c, k))
+}
+
+/// The gradients of [`solid_angle_gradients`] alone, for a caller that has the angles.
+pub fn gradients(c: &[[f64; 3]; 4], k: usize) -> [[f64; 3]; 4] {
     let det = volume6(c[0], c[1], c[2], c[3]);
     let f = TET_FACES[k];
     // ∂N/∂c_k = −(outward normal of the face opposite k).
@@ -65,5 +69,5 @@ pub fn solid_angle_gradients(c: &[[f64; 3]; 4], k: usize) -> ([f64; 4], [[f64; 3
         let s = 2.0 / (det * det + den * den);
         *g = scale(sub(scale(dn, den), scale(dd, det)), s);
     }
-    (omega, grads)
+    grads
 }

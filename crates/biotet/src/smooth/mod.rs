@@ -239,25 +239,8 @@ pub fn smooth(
         }
     }
 
-    // Node → tets (CSR, tets in increasing order).
-    let mut start = vec![0u32; np + 1];
-    for v in &mesh.tets {
-        for &i in v {
-            start[i as usize + 1] += 1;
-        }
-    }
-    for i in 0..np {
-        start[i + 1] += start[i];
-    }
-    let mut fill = start.clone();
-    let mut star = vec![0u32; 4 * nt];
-    for (t, v) in mesh.tets.iter().enumerate() {
-        for &i in v {
-            star[fill[i as usize] as usize] = t as u32;
-            fill[i as usize] += 1;
-        }
-    }
-    drop(fill);
+    // Node → tets.
+    let (start, star) = incidence(np, &mesh.tets);
 
     // Surface nodes and their label pairs (a node on two different pairs is on a triple line).
     const NO_PAIR: [u32; 2] = [u32::MAX; 2];
@@ -445,8 +428,9 @@ pub fn smooth(
             if let Some(l) = m.loc {
                 kind[v] = Kind::Motion(Motion::Slide(l));
             }
-            for &t in s {
-                tet_min[t as usize] = min4(solid_angles(&mesh.corners(t as usize)));
+            // The cluster has the star's angles at the new position already.
+            for (&t, m) in s.iter().zip(cluster.tet_minima()) {
+                tet_min[t as usize] = m;
                 for &u in &mesh.tets[t as usize] {
                     touched[u as usize] = true;
                 }
@@ -493,4 +477,27 @@ pub fn smooth(
 #[inline]
 fn min4(a: [f64; 4]) -> f64 {
     a[0].min(a[1]).min(a[2]).min(a[3])
+}
+
+/// The cells around each of `n` vertices (compressed rows): the cells of vertex `v` are
+/// `cells_of[start[v]..start[v + 1]]`, in increasing order. Every index of `cells` is below `n`.
+pub(crate) fn incidence<const K: usize>(n: usize, cells: &[[u32; K]]) -> (Vec<u32>, Vec<u32>) {
+    let mut start = vec![0u32; n + 1];
+    for c in cells {
+        for &i in c {
+            start[i as usize + 1] += 1;
+        }
+    }
+    for i in 0..n {
+        start[i + 1] += start[i];
+    }
+    let mut fill = start.clone();
+    let mut cells_of = vec![0u32; K * cells.len()];
+    for (t, c) in cells.iter().enumerate() {
+        for &i in c {
+            cells_of[fill[i as usize] as usize] = t as u32;
+            fill[i as usize] += 1;
+        }
+    }
+    (start, cells_of)
 }

@@ -10,7 +10,7 @@
 //! It stops when no step improves or after an iteration cap.
 
 use super::ascent::{MAX_ACTIVE, min_norm_point};
-use super::gradient::solid_angle_gradients;
+use super::gradient::gradients;
 use super::slide::{Location, SlideSurface};
 use crate::geom::predicates::{Sign, in_exact_range, orient3d};
 use crate::geom::vec3::{add, dot, norm, norm2, scale, sub};
@@ -46,6 +46,10 @@ pub(crate) struct Cluster {
     trial: Vec<[f64; 4]>,
     /// Gradients with respect to the free node of each tet's four angles.
     grads: Vec<[[f64; 3]; 4]>,
+    /// The angles tied for the minimum: (angle, tet, corner).
+    active: Vec<(f64, usize, usize)>,
+    /// Their gradients, tangential when sliding.
+    g: Vec<[f64; 3]>,
 }
 
 /// The result of moving one node.
@@ -70,6 +74,14 @@ impl Cluster {
         }
     }
 
+    /// The smallest solid angle of each tet of the cluster at the free node's current position
+    /// (after [`Cluster::optimise`]: where it left the node), in the order of the loaded star.
+    pub fn tet_minima(&self) -> impl Iterator<Item = f64> + '_ {
+        self.angles
+            .iter()
+            .map(|a| a[0].min(a[1]).min(a[2]).min(a[3]))
+    }
+
     /// The cluster's minimum solid angle at the loaded position, `angles` filled.
     fn measure(&mut self) -> f64 {
         self.angles.clear();
@@ -82,9 +94,15 @@ impl Cluster {
         phi
     }
 
-    /// Φ at `x` into `trial` if it is strictly above `floor`, the cluster's soft measure does not
-    /// fall, and every tet is strictly positive (exact); `None` otherwise.
-    fn try_at(&mut self, x: [f64; 3], floor: f64) -> Option<f64> {
+    /// Φ at `x` and the cluster's soft measure there, the angles into `trial`, if Φ is strictly
+    /// above `floor`, the soft measure does not fall, and every tet is strictly positive (exact);
+    /// `None` otherwise. `soft_old` caches the soft measure of `angles` (filled when first needed).
+    fn try_at(
+        &mut self,
+        x: [f64; 3],
+        floor: f64,
+        soft_old: &mut Option<f64>,
+    ) -> Option<(f64, f64)> {
         if !x.iter().all(|&c| c.is_finite() && in_exact_range(c)) {
             return None;
         }
@@ -106,13 +124,8 @@ impl Cluster {
         // of the angles (each capped at the regular tet's, so that flattening a large angle
         // counts for nothing) must not fall. Without it, max-min drags the cluster's other
         // angles down to the minimum and fattens the low end of the histogram.
-        let (mut soft_new, mut soft_old) = (0.0, 0.0);
-        for (new, old) in self.trial.iter().zip(&self.angles) {
-            for i in 0..4 {
-                soft_new += new[i].min(REGULAR_SOLID_ANGLE).ln();
-                soft_old += old[i].min(REGULAR_SOLID_ANGLE).ln();
-            }
-        }
+        let soft_new = soft(&self.trial);
+        let soft_old = *soft_old.get_or_insert_with(|| soft(&self.angles));
         if soft_new.is_nan() || soft_new < soft_old {
             return None;
         }
@@ -123,7 +136,7 @@ impl Cluster {
                 return None;
             }
         }
-        Some(phi)
+        Some((phi, soft_new))
     }
 
     /// Move the free node, starting at `x0`; `None` when it stays where it is.
@@ -155,15 +168,17 @@ impl Cluster {
         let delta_max = p.step_fraction * size / n as f64;
         let min_step = 1e-9 * delta_max;
         let (mut x, mut loc, mut phi) = (x0, motion, phi0);
-        let mut active: Vec<(f64, usize, usize)> = Vec::with_capacity(16);
-        let mut g: Vec<[f64; 3]> = Vec::with_capacity(MAX_ACTIVE);
+        // The soft measure of `angles` once known, carried from an accepted trial to the next.
+        let mut soft_x = None;
+        let mut active = std::mem::take(&mut self.active);
+        let mut g = std::mem::take(&mut self.g);
         for _ in 0..p.max_iterations {
             // Gradients of every angle (for the active set and the step prediction).
             self.grads.clear();
             for (c, &k) in self.corners.iter().zip(&self.local) {
                 let mut c = *c;
                 c[k] = x;
-                self.grads.push(solid_angle_gradients(&c, k).1);
+                self.grads.push(gradients(&c, k));
             }
             let normal = match (loc, surface) {
                 (Motion::Slide(l), Some(s)) => Some(s.normal(&l)),
@@ -224,19 +239,24 @@ impl Cluster {
                     _ => Some((add(x, step), Motion::Free)),
                 };
                 if let Some((nx, nl)) = cand
-                    && let Some(np) = self.try_at(nx, phi)
+                    && let Some((np, ns)) = self.try_at(nx, phi, &mut soft_x)
                 {
-                    accepted = Some((nx, nl, np));
+                    accepted = Some((nx, nl, np, ns));
                     break;
                 }
                 alpha *= 0.5;
             }
-            let Some((nx, nl, np)) = accepted else { break };
+            let Some((nx, nl, np, ns)) = accepted else {
+                break;
+            };
             x = nx;
             loc = nl;
             phi = np;
+            soft_x = Some(ns);
             std::mem::swap(&mut self.angles, &mut self.trial);
         }
+        self.active = active;
+        self.g = g;
         (x != x0).then_some(Moved {
             x,
             loc: match loc {
@@ -247,4 +267,16 @@ impl Cluster {
             phi_after: phi,
         })
     }
+}
+
+/// The cluster's soft measure: the sum over all its angles of the logarithm of the angle, capped
+/// at the regular tet's (see [`Cluster::try_at`]).
+fn soft(angles: &[[f64; 4]]) -> f64 {
+    let mut s = 0.0;
+    for a in angles {
+        for &w in a {
+            s += w.min(REGULAR_SOLID_ANGLE).ln();
+        }
+    }
+    s
 }

@@ -133,23 +133,7 @@ impl SlideSurface {
             }
             i = j;
         }
-        let mut fan_start = vec![0u32; np + 1];
-        for v in &s.triangles {
-            for &x in v {
-                fan_start[x as usize + 1] += 1;
-            }
-        }
-        for i in 0..np {
-            fan_start[i + 1] += fan_start[i];
-        }
-        let mut fill = fan_start.clone();
-        let mut fan = vec![0u32; 3 * nt];
-        for (t, v) in s.triangles.iter().enumerate() {
-            for &x in v {
-                fan[fill[x as usize] as usize] = t as u32;
-                fill[x as usize] += 1;
-            }
-        }
+        let (fan_start, fan) = super::incidence(np, &s.triangles);
         let mut by_coords = FxHashMap::default();
         for (i, p) in s.points.iter().enumerate() {
             by_coords.entry(key(*p)).or_insert(i as u32);
