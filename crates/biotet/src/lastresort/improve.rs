@@ -29,7 +29,7 @@ use serde::Serialize;
 
 use super::search::{SearchOptions, Searcher};
 use crate::mesh::tet::{NO_NEIGHBOR, TET_FACES, TetMesh};
-use crate::quality::tet::{dihedral_angles, q_measure};
+use crate::quality::tet::{dihedral_angles, dihedral_at, q_measure};
 use crate::quality::tri::min_angle_3d_deg;
 
 type P3 = [f64; 3];
@@ -190,6 +190,8 @@ struct Work<'a> {
     rounds: Vec<u32>,
     /// Per tet: 0 unknown, 1 forced, 2 not forced.
     forced: Vec<u8>,
+    /// Per point: on a boundary or interface face (fixed: those faces never change).
+    on_boundary: Vec<bool>,
     /// Per tet: its metric and q (NaN until computed).
     cache: Vec<[f64; 2]>,
     vtet: Vec<u32>,
@@ -313,8 +315,14 @@ impl<'a> Work<'a> {
             old_worst = old_worst.min(m);
             old_q = old_q.min(q);
         }
+        // With the dihedral metric, candidates must also beat the cavity's worst angle (by more
+        // than rounding: the search's formula differs), so every fill found is accepted.
         let so = SearchOptions {
             min_quality: old_q.max(0.0),
+            min_dihedral: match self.opts.metric {
+                Metric::Q => 0.0,
+                Metric::Dihedral => old_worst.max(0.0) * (1.0 + 1e-9),
+            },
             max_nodes: self.opts.max_nodes,
             improve: Some(self.opts.improve_nodes),
         };
@@ -479,6 +487,10 @@ impl<'a> Work<'a> {
 
     fn compute_forced(&self, tet: u32) -> bool {
         let tv = self.tets[tet as usize];
+        // Forcing needs a boundary face or edge: two corners on the boundary at least.
+        if tv.iter().filter(|&&v| self.on_boundary[v as usize]).count() < 2 {
+            return false;
+        }
         let label = self.labels[tet as usize];
         let lim = self.opts.forced_deg;
         let fixed = |n: u32| n == NO_NEIGHBOR || self.labels[n as usize] != label;
@@ -493,6 +505,9 @@ impl<'a> Work<'a> {
         // A boundary edge: the wedge of this region around it, summed over its tets.
         for e in crate::mesh::tet::TET_EDGES {
             let (a, b) = (tv[e[0]], tv[e[1]]);
+            if !self.on_boundary[a as usize] || !self.on_boundary[b as usize] {
+                continue;
+            }
             if let Some(w) = self.wedge(tet, a, b, label)
                 && w.to_degrees() < lim
             {
@@ -514,9 +529,11 @@ impl<'a> Work<'a> {
                 .iter()
                 .position(|&[x, y]| (x == ia && y == ib) || (x == ib && y == ia))
                 .unwrap_or(0);
-            dihedral_angles(&self.corners(t))[e]
+            dihedral_at(&self.corners(t), e)
         };
-        let mut sum = angle_at(tet);
+        // Walk both ways around the edge first (no geometry): most edges are interior.
+        let mut ring = [0u32; 66];
+        let mut n = 0;
         let tv = self.tets[tet as usize];
         let mut open = false;
         for (i, &x) in tv.iter().enumerate() {
@@ -525,28 +542,27 @@ impl<'a> Work<'a> {
             }
             // Walk away from tet across face i around the edge until the region ends.
             let (mut prev, mut t) = (tet, self.nb[tet as usize][i]);
-            let mut steps = 0;
             loop {
                 if t == NO_NEIGHBOR || self.labels[t as usize] != label {
                     open = true;
                     break;
                 }
-                if t == tet || steps > 64 {
+                if t == tet || n == ring.len() {
                     return None; // closed ring: an interior edge
                 }
-                sum += angle_at(t);
+                ring[n] = t;
+                n += 1;
                 let v = self.tets[t as usize];
                 let next = (0..4)
                     .filter(|&k| v[k] != a && v[k] != b)
                     .map(|k| self.nb[t as usize][k])
-                    .find(|&n| n != prev)
+                    .find(|&nb| nb != prev)
                     .unwrap_or(NO_NEIGHBOR);
                 prev = t;
                 t = next;
-                steps += 1;
             }
         }
-        open.then_some(sum)
+        open.then(|| angle_at(tet) + ring[..n].iter().map(|&t| angle_at(t)).sum::<f64>())
     }
 
     fn queue_push(&mut self, value: f64, tet: u32) {
@@ -566,6 +582,7 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
         alive: Vec::new(),
         rounds: Vec::new(),
         forced: Vec::new(),
+        on_boundary: vec![false; mesh.points.len()],
         cache: Vec::new(),
         vtet: vec![NO_NEIGHBOR; mesh.points.len()],
         free: Vec::new(),
@@ -585,6 +602,16 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     w.alive = vec![true; n];
     w.rounds = vec![0; n];
     w.forced = vec![0; n];
+    for t in 0..n {
+        for (i, f) in TET_FACES.iter().enumerate() {
+            let nb = w.nb[t][i];
+            if nb == NO_NEIGHBOR || w.labels[nb as usize] != w.labels[t] {
+                for &k in f {
+                    w.on_boundary[w.tets[t][k] as usize] = true;
+                }
+            }
+        }
+    }
     w.cache = vec![[f64::NAN; 2]; n];
     w.report.n_tets_before = n;
     for t in 0..n {

@@ -23,6 +23,40 @@ pub fn dihedral_angles(c: &[[f64; 3]; 4]) -> [f64; 6] {
     out
 }
 
+/// The interior dihedral angle (radians) at edge `e` of [`TET_EDGES`] alone: the same value as
+/// `dihedral_angles(c)[e]`, for callers that need one edge.
+pub fn dihedral_at(c: &[[f64; 3]; 4], e: usize) -> f64 {
+    let f = crate::mesh::tet::TET_FACES;
+    let [k, l] = TET_EDGES[5 - e];
+    let normal = |i: usize| {
+        let (a, b, cc) = (c[f[i][0]], c[f[i][1]], c[f[i][2]]);
+        cross(sub(b, a), sub(cc, a))
+    };
+    let (nk, nl) = (normal(k), normal(l));
+    norm(cross(nk, nl)).atan2(-dot(nk, nl))
+}
+
+/// `4·sin²(θ/2)` of the smallest interior dihedral angle θ: increasing in θ, computed without
+/// trigonometry and without cancellation for small angles (as `|u + v|²` of the two faces' unit
+/// outward normals), for ranking many tets cheaply. 0 for a degenerate tet.
+pub fn min_dihedral_chord2(c: &[[f64; 3]; 4]) -> f64 {
+    let n = face_normals(c);
+    let mut u = [[0.0; 3]; 4];
+    for (ui, ni) in u.iter_mut().zip(&n) {
+        let l = norm(*ni);
+        if l == 0.0 {
+            return 0.0;
+        }
+        *ui = scale(*ni, 1.0 / l);
+    }
+    let mut worst = f64::INFINITY;
+    for e in 0..6 {
+        let [k, l] = TET_EDGES[e];
+        worst = worst.min(norm2(add(u[k], u[l])));
+    }
+    worst
+}
+
 /// Outward normals (length = twice the face area) of the faces opposite each vertex, for a
 /// positively oriented tet.
 fn face_normals(c: &[[f64; 3]; 4]) -> [[f64; 3]; 4] {
