@@ -75,7 +75,7 @@ impl Default for ImproveOptions {
             metric: Metric::Dihedral,
             threshold: 10.0,
             local_moves: true,
-            grow: true,
+            grow: std::env::var_os("NOGROW").is_none(),
             max_nodes: 500,
             improve_nodes: 100,
             max_cavity_tets: 400,
