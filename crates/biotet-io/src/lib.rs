@@ -260,7 +260,11 @@ pub fn mesh_kind(path: &Path) -> Result<MeshKind> {
     match ext(path).as_str() {
         "stl" | "obj" | "off" | "ply" => Ok(MeshKind::Surface),
         "msh" => Ok(MeshKind::Tetrahedra),
-        "vtu" => vtu::peek_kind(&atomic::read_file(path)?, &name(path)),
+        // Unreadable: by extension; reading it will say why.
+        "vtu" => match atomic::read_file(path) {
+            Ok(data) => vtu::peek_kind(&data, &name(path)),
+            Err(_) => Ok(MeshKind::Tetrahedra),
+        },
         "mesh" => medit::peek_kind(atomic::open(path)?, &name(path)),
         "node" | "ele" => {
             let node = tetgen::files(path).node;
