@@ -103,7 +103,9 @@ fn main() -> ExitCode {
             // A surface refused by validation is an invalid input, not a failure to run.
             let refused = e
                 .downcast_ref::<biotet::mesh::validate::SurfaceError>()
-                .is_some();
+                .is_some()
+                || e.downcast_ref::<biotet::mesh::side_labels::SideLabelError>()
+                    .is_some();
             ExitCode::from(if refused { EXIT_INVALID } else { EXIT_ERROR })
         }
     }

@@ -6,6 +6,7 @@
 
 pub mod inside;
 pub mod shells;
+pub mod side_labels;
 pub mod surface;
 pub mod tet;
 pub mod tri;

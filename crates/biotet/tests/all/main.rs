@@ -8,6 +8,7 @@ mod lastresort;
 mod predicates;
 mod quality;
 mod shells;
+mod side_labels;
 mod sizing;
 mod sizing_grid;
 mod smooth;
