@@ -1017,6 +1017,16 @@ impl<'a> Recovery<'a> {
                 self.alive[s as usize] = true;
                 s
             } else {
+                if self.mesh.tets.len() == self.mesh.tets.capacity() {
+                    // Grow by an eighth, not double: a fill adds few tets beyond the ones it
+                    // frees, and doubling the mesh arrays would set the peak memory.
+                    let extra = self.mesh.tets.len() / 8 + 64;
+                    self.mesh.tets.reserve_exact(extra);
+                    self.mesh.labels.reserve_exact(extra);
+                    self.mesh.neighbors.reserve_exact(extra);
+                    self.alive.reserve_exact(extra);
+                    self.tet_mark.reserve_exact(extra);
+                }
                 self.mesh.tets.push(*t);
                 self.mesh.labels.push(label);
                 self.mesh.neighbors.push([NO_NEIGHBOR; 4]);
@@ -1132,21 +1142,46 @@ impl<'a> Recovery<'a> {
         self.retain_tets(|r, t| r.alive[t]);
     }
 
-    /// Keep the tets for which `keep` holds (in order), rebuild adjacency and incidences;
-    /// returns how many were removed.
+    /// Keep the tets for which `keep` holds (in order), renumber the adjacency (kept up to date
+    /// by every insertion, so no rebuild and no sort) and rebuild the incidences; returns how
+    /// many were removed.
     fn retain_tets(&mut self, keep: impl Fn(&Self, usize) -> bool) -> usize {
         let before = self.mesh.tets.len();
-        let mut k = 0;
-        for t in 0..before {
+        let mut index = vec![NO_NEIGHBOR; before];
+        let mut k = 0u32;
+        for (t, slot) in index.iter_mut().enumerate() {
             if keep(self, t) {
-                self.mesh.tets[k] = self.mesh.tets[t];
-                self.mesh.labels[k] = self.mesh.labels[t];
+                *slot = k;
                 k += 1;
             }
         }
+        for t in 0..before {
+            let new = index[t];
+            if new == NO_NEIGHBOR {
+                continue;
+            }
+            let nb = self.mesh.neighbors[t].map(|n| {
+                if n == NO_NEIGHBOR {
+                    n
+                } else {
+                    index[n as usize]
+                }
+            });
+            let new = new as usize;
+            self.mesh.tets[new] = self.mesh.tets[t];
+            self.mesh.labels[new] = self.mesh.labels[t];
+            self.mesh.neighbors[new] = nb;
+        }
+        drop(index);
+        let k = k as usize;
         self.mesh.tets.truncate(k);
         self.mesh.labels.truncate(k);
-        self.mesh.rebuild_neighbors();
+        self.mesh.neighbors.truncate(k);
+        debug_assert_eq!(
+            self.mesh.neighbors,
+            crate::mesh::tet::face_adjacency(&self.mesh.tets).0,
+            "recovery keeps the adjacency"
+        );
         self.index();
         before - k
     }
