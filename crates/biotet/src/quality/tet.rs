@@ -50,8 +50,7 @@ pub fn min_dihedral_chord2(c: &[[f64; 3]; 4]) -> f64 {
         *ui = scale(*ni, 1.0 / l);
     }
     let mut worst = f64::INFINITY;
-    for e in 0..6 {
-        let [k, l] = TET_EDGES[e];
+    for [k, l] in TET_EDGES {
         worst = worst.min(norm2(add(u[k], u[l])));
     }
     worst

@@ -812,8 +812,9 @@ fn single_edge_dihedral_and_chord_agree_with_all_angles() {
         if k % 3 == 0 {
             // Flatten: the fourth point close to the plane of the first three.
             let t = 10f64.powi(-(k % 9) - 1);
-            for i in 0..3 {
-                c[3][i] = (c[0][i] + c[1][i] + c[2][i]) / 3.0 * (1.0 - t) + c[3][i] * t;
+            let [a, b, d] = [c[0], c[1], c[2]];
+            for (i, x) in c[3].iter_mut().enumerate() {
+                *x = (a[i] + b[i] + d[i]) / 3.0 * (1.0 - t) + *x * t;
             }
         }
         let all = quality::tet::dihedral_angles(&c);
