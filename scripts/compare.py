@@ -87,9 +87,11 @@ class Runner:
         self.tetgen_base = None  # the TetGen pq1.2Y mesh, MMG's input
 
     def path(self, name):
+        """A file in the scratch directory."""
         return os.path.join(self.tmp, name)
 
     def biotet_mesh(self):
+        """`biotet mesh` with its defaults; seconds and memory from its --json (reading excluded)."""
         out, rows = self.path("biotet.vtu"), []
         for _ in range(self.repeat):
             start = time.perf_counter()
@@ -99,6 +101,7 @@ class Runner:
         return out, rows, ""
 
     def child(self, tool, base, **opts):
+        """A Python mesher child `--repeat` times; its output is base.node/.ele."""
         rows = []
         for _ in range(self.repeat):
             j = run_child(tool, self.surface, base, **opts)
@@ -106,6 +109,7 @@ class Runner:
         return base + ".node", rows
 
     def tetgen(self, switches):
+        """pip TetGen with `switches`; the `pq1.2Y` mesh is kept as MMG's input."""
         base = self.path("tetgen_" + switches)
         out, rows = self.child("tetgen", base, switches=switches)
         if switches == "pq1.2Y":
@@ -113,13 +117,16 @@ class Runner:
         return out, rows, ""
 
     def gmsh(self):
+        """Gmsh's 3D Delaunay inside the kept surface."""
         return (*self.child("gmsh", self.path("gmsh")), "")
 
     def ftetwild(self):
+        """fTetWild through pytetwild."""
         out, rows = self.child("ftetwild", self.path("ftetwild"), threads=self.ftetwild_threads)
         return out, rows, "surface approximated (not kept)"
 
     def mmg(self):
+        """MMG3D `-optim -nosurf` on the TetGen `pq1.2Y` mesh (made here if the tetgen tool did not run)."""
         if self.tetgen_base is None:
             self.tetgen_base = self.path("tetgen_pq1.2Y")
             run_child("tetgen", self.surface, self.tetgen_base, switches="pq1.2Y")
@@ -142,6 +149,7 @@ class Runner:
         return final + ".node", rows, f"{moved} points snapped onto the input surface"
 
     def run(self, tool):
+        """Run `tool`: returns (output mesh, one dict per run with seconds, wall and kb, a note)."""
         if tool == "biotet":
             return self.biotet_mesh()
         if tool == "tetgen":
@@ -173,6 +181,7 @@ def num(v, spec=","):
 
 
 def angle(v, digits):
+    """An angle cell in degrees."""
     return "–" if v is None else f"{v:.{digits}f}°"
 
 
@@ -258,6 +267,7 @@ def versions():
 
 
 def markdown_block(rows, command, machine_start, machine_end, repeat):
+    """The block for the README: how it was made, the machine, both tables, the ratios and the notes."""
     notes = [f"- {r['surface']}, {r['label']}: {r['note']}" for r in rows if r.get("note")]
     return "\n".join([
         f"Made by `{command}` (median of {repeat} run{'s' if repeat != 1 else ''} per tool, each in a child "
@@ -279,6 +289,7 @@ def markdown_block(rows, command, machine_start, machine_end, repeat):
 
 
 def write_csv(path, rows):
+    """One CSV row per surface and tool (the columns of CSV_COLUMNS; histograms only in --json)."""
     with open(path, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=CSV_COLUMNS, extrasaction="ignore")
         w.writeheader()
