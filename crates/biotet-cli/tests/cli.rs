@@ -113,6 +113,65 @@ fn quality_of_the_bundled_example() {
 }
 
 #[test]
+fn quality_with_the_surface_splits_by_placement_and_counts_forced_tets() {
+    let plain = json_of(&biotet(&["quality", s(&example()), "--json"]));
+    let j = json_of(&biotet(&[
+        "quality",
+        s(&example()),
+        "--surface",
+        s(&brain_surface()),
+        "--json",
+    ]));
+    // The report itself is unchanged; the split is added beside it.
+    for k in QUALITY_KEYS {
+        assert_eq!(j[k], plain[k], "{k}");
+    }
+    let place = &j["placement"];
+    let count = |class: &str, key: &str| place[class][key].as_u64().unwrap();
+    let classes = ["face", "vertex", "interior"];
+    // Every tet is in one class, and each class's poor tets add up to the whole mesh's.
+    for (key, total) in [
+        ("n_tets", "n_tets"),
+        ("n_dihedral_lt_5", "n_dihedral_lt_5"),
+        ("n_dihedral_lt_10", "n_dihedral_lt_10"),
+        ("n_dihedral_lt_20", "n_dihedral_lt_20"),
+    ] {
+        let sum: u64 = classes.iter().map(|c| count(c, key)).sum();
+        assert_eq!(sum, j[total].as_u64().unwrap(), "{key}");
+    }
+    // TetGen -Y keeps all 19,648 input triangles as faces, each of one tet (the closed surface
+    // bounds one side), a tet holding at most three of them.
+    let face = count("face", "n_tets");
+    assert!(face <= 19648 && 3 * face >= 19648, "{face}");
+    // The marching-cubes triangles force poor tets, all of them on the surface.
+    let forced = j["n_forced"].as_u64().unwrap();
+    assert!(forced > 1000, "{forced}");
+    assert_eq!(
+        forced,
+        classes.iter().map(|c| count(c, "n_forced")).sum::<u64>()
+    );
+    assert_eq!(count("interior", "n_forced"), 0);
+    assert_eq!(j["forcing"]["n_forced"], j["n_forced"]);
+    let unforced = j["n_unforced_dihedral_lt_10"].as_u64().unwrap();
+    let lt10 = j["n_dihedral_lt_10"].as_u64().unwrap();
+    assert!(unforced > 0 && unforced < lt10, "{unforced} of {lt10}");
+    // The smallest dihedral angle of the mesh is the smallest of the classes'.
+    let min_of = |c: &str| place[c]["min_dihedral_deg"].as_f64().unwrap();
+    let m = classes
+        .iter()
+        .map(|c| min_of(c))
+        .fold(f64::INFINITY, f64::min);
+    assert_eq!(m, j["min_dihedral_deg"].as_f64().unwrap());
+    // The text report says the same.
+    let text = biotet(&["quality", s(&example()), "-s", s(&brain_surface())]);
+    let text = String::from_utf8_lossy(&text.stdout);
+    assert!(
+        text.contains("by placement") && text.contains(&format!("{forced} tets")),
+        "{text}"
+    );
+}
+
+#[test]
 fn the_bundled_example_passes_the_checker_with_its_surface() {
     let out = biotet(&[
         "check",
