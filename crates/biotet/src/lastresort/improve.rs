@@ -710,7 +710,7 @@ impl<'a> Work<'a> {
 }
 
 /// Tasks per batch (fixed, so that results do not depend on the number of threads).
-const BATCH: usize = 32;
+const BATCH: usize = 128;
 
 /// What [`step`] made of one bad tet.
 enum Step {
@@ -718,7 +718,7 @@ enum Step {
     Done,
     /// Its seed's cavity, to search in the batch.
     Task(Box<Task>),
-    /// It touches the pending batch: run the batch first, then come back.
+    /// It touches the pending batch: it waits until the batch is done.
     Conflict,
 }
 
@@ -902,32 +902,38 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     // does the result. Local moves run at once, unless they touch the pending batch.
     let mut scratch = Vec::new();
     let mut batch: Vec<Task> = Vec::new();
+    // Tets whose moves touch the pending batch wait for it (in their order), so that a cluster
+    // of bad tets does not cut the batches short.
+    let mut waiting: Vec<Entry> = Vec::new();
     loop {
         let entry = w.queue.pop();
         let flush = match entry {
             None => true,
-            Some(Entry { tet, value }) => {
-                if !w.alive[tet as usize] || w.value(tet) != value {
+            Some(e) => {
+                if !w.alive[e.tet as usize] || w.value(e.tet) != e.value {
                     continue;
                 }
-                match step(&mut w, tet, &mut scratch) {
+                match step(&mut w, e.tet, &mut scratch) {
                     Step::Done => false,
                     Step::Task(t) => {
                         batch.push(*t);
                         batch.len() >= BATCH
                     }
                     Step::Conflict => {
-                        w.queue_push(value, tet);
-                        true
+                        waiting.push(e);
+                        waiting.len() >= 2 * BATCH
                     }
                 }
             }
         };
         if flush {
-            if batch.is_empty() && entry.is_none() {
+            if batch.is_empty() && waiting.is_empty() && entry.is_none() {
                 break;
             }
             run_batch(&mut w, &mut batch);
+            for e in waiting.drain(..) {
+                w.queue.push(e);
+            }
         }
     }
     // Compact.
