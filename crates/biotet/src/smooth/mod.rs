@@ -5,8 +5,12 @@
 //! the cluster (at every corner, not only at the node) as a function of the node's position
 //! (eq. 4.7). `node` raises Φ along the analytic gradient (eq. 4.8; [`gradient`]), or, when
 //! several angles are nearly tied, along the ascent direction of all of them ([`ascent`]).
-//! A sweep visits the movable nodes worst cluster first, Gauss–Seidel style (each node sees its
-//! neighbours' new positions); sweeps repeat until the smallest solid angle of the tets that can
+//! A sweep colours the movable nodes to visit greedily, worst cluster first, so that no two nodes
+//! of a colour share a tet (`colour`); the classes run in colour order, Gauss–Seidel style
+//! between classes (each node sees the new positions of the classes before it), and each class
+//! is computed in parallel (rayon) from the positions before it and applied after. Most refused
+//! trial positions are proved refused by cheap bounds (`screen`) before the exact test. Sweeps
+//! repeat until the smallest solid angle of the tets that can
 //! change stops rising, the largest displacement falls below a fraction of the smallest edge, or
 //! the sweep cap.
 //!
@@ -20,7 +24,9 @@
 //!   (interfaces) — with [`Boundary::Fixed`] never move (bit-identical); with [`Boundary::Slide`]
 //!   they move along the input surface and stay on its triangles up to round-off ([`slide`]),
 //!   while nodes on feature edges and corners, on triple lines, or not at a surface vertex stay.
-//! - Deterministic: one order of operations, so the same input gives the same output bit for bit.
+//! - Deterministic: the same input gives the same output bit for bit, for any number of threads
+//!   (a class's nodes read nothing another of them writes, and every reduction is a minimum or
+//!   runs in a fixed order).
 
 pub mod ascent;
 mod colour;
