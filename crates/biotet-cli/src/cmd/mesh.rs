@@ -185,6 +185,8 @@ pub fn run(a: Args) -> Result<ExitCode> {
         let f = forced::classify(&mesh, &surface, FORCED_DEG);
         forced::summarise(&mesh, &f, FORCED_DEG)
     };
+    // The peak of meshing alone, before the writer builds its arrays.
+    let (peak_meshing_kb, _) = super::delaunay::memory_kb();
     if let Some(out) = &a.output {
         stage.set(format!("writing {}", out.display()));
         biotet_io::write_tet_mesh(out, &mesh)?;
@@ -206,6 +208,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
             "forcing": forcing,
             "rss_before_kb": rss_before_kb,
             "peak_rss_kb": peak_kb,
+            "peak_rss_meshing_kb": peak_meshing_kb,
             "mesh_bytes": mesh.bytes(),
         }))?);
     } else if !a.common.quiet {

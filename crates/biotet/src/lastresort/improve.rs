@@ -945,22 +945,36 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
             k += 1;
         }
     }
-    let mut tets = Vec::with_capacity(k as usize);
-    let mut nb = Vec::with_capacity(k as usize);
-    let mut labels = Vec::with_capacity(k as usize);
-    for t in 0..w.tets.len() {
-        if w.alive[t] {
-            tets.push(w.tets[t]);
-            nb.push(w.nb[t].map(|n| {
-                if n == NO_NEIGHBOR {
-                    n
-                } else {
-                    index[n as usize]
-                }
-            }));
-            labels.push(w.labels[t]);
+    // In place (new index <= old index), so the mesh is never held twice.
+    let scratch_len = w.tets.len();
+    for t in 0..scratch_len {
+        let new = index[t];
+        if new == NO_NEIGHBOR {
+            continue;
         }
+        let nb = w.nb[t].map(|n| {
+            if n == NO_NEIGHBOR {
+                n
+            } else {
+                index[n as usize]
+            }
+        });
+        let new = new as usize;
+        w.tets[new] = w.tets[t];
+        w.nb[new] = nb;
+        w.labels[new] = w.labels[t];
     }
+    drop(index);
+    let k = k as usize;
+    let mut tets = std::mem::take(&mut w.tets);
+    let mut nb = std::mem::take(&mut w.nb);
+    let mut labels = std::mem::take(&mut w.labels);
+    tets.truncate(k);
+    nb.truncate(k);
+    labels.truncate(k);
+    tets.shrink_to_fit();
+    nb.shrink_to_fit();
+    labels.shrink_to_fit();
     let pts = &mesh.points;
     let bad_after = tets
         .iter()

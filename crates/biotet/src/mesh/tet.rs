@@ -125,53 +125,61 @@ pub(crate) fn sorted3(mut f: [u32; 3]) -> [u32; 3] {
     f
 }
 
-/// Face adjacency of a tet array: `(neighbors, faces in more than two tets)`. The faces are
-/// bucketed by their smallest corner (a counting sort, linear), and each small bucket is sorted
-/// by its other two corners, so matching faces meet: no hashing, deterministic (the first two
-/// tets of a face, by tet and face index, are paired).
+/// Face adjacency of a tet array: `(neighbors, faces in more than two tets)`. Each face is
+/// matched among the tets around its corner of fewest tets (a vertex-to-tet incidence built by
+/// a counting sort): linear, no hashing, no sort, and 16 bytes per tet of scratch (the mesh
+/// itself is 36), so it never sets a meshing run's peak memory. Deterministic: a face's two
+/// tets of smallest index are paired.
 pub fn face_adjacency(tets: &[[u32; 4]]) -> (Vec<[u32; 4]>, usize) {
     let n_vertices = tets.iter().flatten().max().map_or(0, |&m| m as usize + 1);
     let mut start = vec![0u32; n_vertices + 1];
-    for v in tets {
-        for l in TET_FACES {
-            let m = v[l[0]].min(v[l[1]]).min(v[l[2]]);
-            start[m as usize + 1] += 1;
-        }
+    for &v in tets.iter().flatten() {
+        start[v as usize + 1] += 1;
     }
     for i in 0..n_vertices {
         start[i + 1] += start[i];
     }
-    // (other two corners packed, tet << 2 | face), grouped by smallest corner.
-    let mut keys = vec![(0u64, 0u32); tets.len() * 4];
+    // Tets around each vertex, in increasing tet order.
+    let mut inc = vec![0u32; tets.len() * 4];
     let mut fill = start.clone();
     for (t, v) in tets.iter().enumerate() {
-        for (f, l) in TET_FACES.iter().enumerate() {
-            let [a, b, c] = sorted3([v[l[0]], v[l[1]], v[l[2]]]);
-            let slot = &mut fill[a as usize];
-            keys[*slot as usize] = ((b as u64) << 32 | c as u64, (t as u32) << 2 | f as u32);
-            *slot += 1;
+        for &x in v {
+            inc[fill[x as usize] as usize] = t as u32;
+            fill[x as usize] += 1;
         }
     }
+    drop(fill);
+    let around = |x: u32| &inc[start[x as usize] as usize..start[x as usize + 1] as usize];
     let mut nb = vec![[NO_NEIGHBOR; 4]; tets.len()];
     let mut over = 0;
-    for w in start.windows(2) {
-        let bucket = &mut keys[w[0] as usize..w[1] as usize];
-        bucket.sort_unstable();
-        let mut i = 0;
-        while i < bucket.len() {
-            let mut j = i + 1;
-            while j < bucket.len() && bucket[j].0 == bucket[i].0 {
-                j += 1;
+    let mut found: Vec<(u32, usize)> = Vec::new();
+    for (t, v) in tets.iter().enumerate() {
+        for (f, l) in TET_FACES.iter().enumerate() {
+            if nb[t][f] != NO_NEIGHBOR {
+                continue;
             }
-            if j - i >= 2 {
-                let (a, b) = (bucket[i].1, bucket[i + 1].1);
-                nb[(a >> 2) as usize][(a & 3) as usize] = b >> 2;
-                nb[(b >> 2) as usize][(b & 3) as usize] = a >> 2;
-                if j - i > 2 {
+            let face = [v[l[0]], v[l[1]], v[l[2]]];
+            let pivot = *face
+                .iter()
+                .min_by_key(|&&x| start[x as usize + 1] - start[x as usize])
+                .unwrap_or(&face[0]);
+            // Every tet holding the face, in tet order, with the face's local index.
+            found.clear();
+            for &u in around(pivot) {
+                let w = tets[u as usize];
+                if face.iter().all(|x| w.contains(x)) {
+                    let k = (0..4).find(|&k| !face.contains(&w[k])).unwrap_or(0);
+                    found.push((u, k));
+                }
+            }
+            if found.len() >= 2 && found[0].0 == t as u32 {
+                let ((a, fa), (b, fb)) = (found[0], found[1]);
+                nb[a as usize][fa] = b;
+                nb[b as usize][fb] = a;
+                if found.len() > 2 {
                     over += 1;
                 }
             }
-            i = j;
         }
     }
     (nb, over)
