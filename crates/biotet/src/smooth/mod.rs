@@ -25,6 +25,7 @@
 pub mod ascent;
 pub mod gradient;
 mod node;
+pub mod plane;
 pub mod slide;
 
 use std::time::Instant;
