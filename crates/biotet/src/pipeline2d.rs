@@ -116,7 +116,15 @@ pub fn mesh_pslg(
             .iter()
             .map(|s| s.map(|v| map[v as usize]))
             .collect();
-        report.smooth = Some(smooth_tri_with_segments(&mut mesh, &segs, so));
+        let hold: Vec<u32> = map.iter().copied().filter(|&v| v != u32::MAX).collect();
+        let hold: Vec<u32> = if so.boundary == crate::smooth::Boundary::Fixed {
+            hold
+        } else {
+            // Sliding: points on segments may slide; isolated input points stay.
+            let on: rustc_hash::FxHashSet<u32> = segs.iter().flatten().copied().collect();
+            hold.into_iter().filter(|v| !on.contains(v)).collect()
+        };
+        report.smooth = Some(smooth_tri_with_segments(&mut mesh, &segs, &hold, so));
         report.seconds_smooth = clock.elapsed().as_secs_f64();
     }
     Ok((mesh, report))

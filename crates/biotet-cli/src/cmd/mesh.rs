@@ -117,6 +117,26 @@ fn parse_region_sizes(items: &[String]) -> Result<Vec<(u32, f64)>> {
 
 /// Run `biotet mesh`.
 pub fn run(a: Args) -> Result<ExitCode> {
+    if let [input] = &a.surfaces[..]
+        && super::plane::is_pslg(input)
+    {
+        return super::plane::mesh(
+            super::plane::MeshArgs {
+                input,
+                output: a.output.as_deref(),
+                size: a.size,
+                resolution: a.resolution,
+                zone: match a.zone {
+                    ZoneArg::Box => Zone::Box,
+                    ZoneArg::Euclidean => Zone::Euclidean,
+                },
+                max_pixels: a.max_voxels,
+                no_smooth: a.no_smooth,
+                svg: a.svg.as_deref(),
+            },
+            a.common,
+        );
+    }
     let clock = Instant::now();
     let stage = Stage::start(a.common.quiet, "reading the surface");
     let (surface, shells, name) = if a.surfaces.is_empty() {

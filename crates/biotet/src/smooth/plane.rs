@@ -255,14 +255,16 @@ impl Smoother<'_> {
 /// Smooth `mesh` in place (see the module docs). The mesh should be valid (counter-clockwise,
 /// conforming); triangles that are not strictly counter-clockwise keep their nodes still.
 pub fn smooth_tri(mesh: &mut TriMesh, o: &PlaneSmoothOptions) -> PlaneSmoothReport {
-    smooth_tri_with_segments(mesh, &[], o)
+    smooth_tri_with_segments(mesh, &[], &[], o)
 }
 
 /// [`smooth_tri`] where the edges `segments` (pairs of point indices) also count as boundary, so
-/// that segments inside one region (open polylines, cracks) are kept like the others.
+/// that segments inside one region (open polylines, cracks) are kept like the others, and the
+/// points `hold` never move (input points off every segment).
 pub fn smooth_tri_with_segments(
     mesh: &mut TriMesh,
     segments: &[[u32; 2]],
+    hold: &[u32],
     o: &PlaneSmoothOptions,
 ) -> PlaneSmoothReport {
     let n = mesh.points.len();
@@ -302,13 +304,21 @@ pub fn smooth_tri_with_segments(
         ..Default::default()
     };
     let mut motion = vec![Motion::Fixed; n];
+    let mut held = vec![false; n];
+    for &v in hold {
+        if let Some(h) = held.get_mut(v as usize) {
+            *h = true;
+        }
+    }
     for v in 0..n {
         if start[v] == start[v + 1] {
             continue;
         }
         report.n_nodes += 1;
         let b = &bnb[v];
-        if b.is_empty() {
+        if held[v] {
+            report.n_fixed += 1;
+        } else if b.is_empty() {
             motion[v] = Motion::Free;
             report.n_free += 1;
         } else if o.boundary == Boundary::Slide && b.len() == 2 {
