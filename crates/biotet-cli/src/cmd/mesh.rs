@@ -88,6 +88,10 @@ pub struct Args {
     /// Skip smoothing.
     #[arg(long)]
     no_smooth: bool,
+    /// 2D only: triangulate the PSLG's own points (isolated points included) without deploying
+    /// template nodes.
+    #[arg(long)]
+    no_deploy: bool,
     /// Draw the output's dihedral- and solid-angle histograms to this SVG.
     #[arg(long, value_name = "FILE")]
     svg: Option<PathBuf>,
@@ -132,6 +136,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
                 },
                 max_pixels: a.max_voxels,
                 no_smooth: a.no_smooth,
+                no_deploy: a.no_deploy,
                 svg: a.svg.as_deref(),
             },
             a.common,

@@ -9,7 +9,7 @@ use anyhow::{Context, Result};
 use biotet::TriMesh;
 use biotet::check2d::check_tri;
 use biotet::mesh::pslg::Pslg;
-use biotet::pipeline2d::{Mesh2dOptions, describe_failure, mesh_pslg};
+use biotet::pipeline2d::{Mesh2dOptions, describe_failure, mesh_pslg, triangulate_pslg};
 use biotet::quality::TriQualityReport;
 use biotet::recover2d::{carve, recover};
 use biotet::smooth::Boundary;
@@ -82,6 +82,8 @@ pub struct MeshArgs<'a> {
     pub max_pixels: usize,
     /// Skip smoothing.
     pub no_smooth: bool,
+    /// Skip node deployment (the PSLG's own points only).
+    pub no_deploy: bool,
     /// Angle histogram SVG.
     pub svg: Option<&'a Path>,
 }
@@ -100,8 +102,26 @@ pub fn mesh(a: MeshArgs, common: Common) -> Result<ExitCode> {
         },
         smooth: (!a.no_smooth).then(PlaneSmoothOptions::default),
     };
-    let (mesh, report) =
-        mesh_pslg(&pslg, &opts).with_context(|| format!("{}: cannot mesh", a.input.display()))?;
+    let (mesh, report) = if a.no_deploy {
+        triangulate_pslg(&pslg, &[]).map(|(mut m, mut r)| {
+            if let Some(so) = &opts.smooth {
+                // Every point but the segments' is free here (the Table 4.1 set-up).
+                let clock = std::time::Instant::now();
+                let map = &r.carve.point_map;
+                let segs: Vec<[u32; 2]> = pslg
+                    .segments
+                    .iter()
+                    .map(|s| s.map(|v| map[v as usize]))
+                    .collect();
+                r.smooth = Some(smooth_tri_with_segments(&mut m, &segs, &[], so));
+                r.seconds_smooth = clock.elapsed().as_secs_f64();
+            }
+            (m, r)
+        })
+    } else {
+        mesh_pslg(&pslg, &opts)
+    }
+    .with_context(|| format!("{}: cannot mesh", a.input.display()))?;
     stage.set("checking");
     let check = check_tri(&mesh, Some(&pslg));
     let quality = TriQualityReport::of(&mesh);

@@ -17,8 +17,9 @@
 //! (two boundary edges at an angle, or more than two) stay.
 //!
 //! Guarantees: only coordinates change; the smallest angle of the mesh never decreases (every
-//! accepted move raises its cluster's smallest angle, computed by the same function as
-//! [`crate::quality::tri`]); fixed nodes are bit-identical; sliding nodes stay on their line up to
+//! accepted move raises its cluster's smallest angle, computed by the formula of
+//! [`crate::quality::tri::angles`] at the corner opposite the shortest edge, so up to round-off
+//! when two edges are within round-off of each other); fixed nodes are bit-identical; sliding nodes stay on their line up to
 //! round-off; deterministic.
 
 use serde::Serialize;
@@ -115,6 +116,37 @@ fn min3(a: [f64; 3]) -> f64 {
     a[0].min(a[1]).min(a[2])
 }
 
+/// A monotone key of the smallest angle of a triangle: `−cos` of the angle opposite its shortest
+/// edge (increasing with the angle on [0, π]; no `atan2` on the smoothing's hot path). Equals
+/// `−cos(min3(angles(c)))` up to round-off.
+fn min_angle_key(c: &[[f64; 2]; 3]) -> f64 {
+    let d = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2);
+    let l = [d(c[1], c[2]), d(c[2], c[0]), d(c[0], c[1])];
+    let i = if l[0] <= l[1] && l[0] <= l[2] {
+        0
+    } else if l[1] <= l[2] {
+        1
+    } else {
+        2
+    };
+    let p = c[i];
+    let a = c[(i + 1) % 3];
+    let b = c[(i + 2) % 3];
+    let u = [a[0] - p[0], a[1] - p[1]];
+    let v = [b[0] - p[0], b[1] - p[1]];
+    let den = (l[(i + 2) % 3] * l[(i + 1) % 3]).sqrt();
+    if den > 0.0 {
+        -((u[0] * v[0] + u[1] * v[1]) / den).clamp(-1.0, 1.0)
+    } else {
+        -1.0
+    }
+}
+
+/// The angle of a key of [`min_angle_key`].
+fn key_angle(k: f64) -> f64 {
+    (-k).clamp(-1.0, 1.0).acos()
+}
+
 /// Gradient of the angle at corner `j` of the (counter-clockwise) triangle `c` with respect to the
 /// position of corner `k`.
 fn angle_gradient(c: &[[f64; 2]; 3], j: usize, k: usize) -> [f64; 2] {
@@ -146,6 +178,8 @@ fn angle_gradient(c: &[[f64; 2]; 3], j: usize, k: usize) -> [f64; 2] {
 
 struct Smoother<'a> {
     m: &'a mut TriMesh,
+    /// Length of each node's last accepted step (0: none yet).
+    last: Vec<f64>,
     start: Vec<u32>,
     star: Vec<u32>,
 }
@@ -161,8 +195,8 @@ impl Smoother<'_> {
         tv.map(|u| if u == v { x } else { self.m.points[u as usize] })
     }
 
-    /// Smallest angle (radians) of the cluster of `v` at `x`; `None` if a triangle is not
-    /// strictly counter-clockwise there.
+    /// Key ([`min_angle_key`]) of the smallest angle of the cluster of `v` at `x`; `None` if a
+    /// triangle is not strictly counter-clockwise there.
     fn phi(&self, v: u32, x: [f64; 2]) -> Option<f64> {
         let mut m = f64::INFINITY;
         for &t in self.cluster(v as usize) {
@@ -170,7 +204,7 @@ impl Smoother<'_> {
             if orient2d(c[0], c[1], c[2]) != Sign::Positive {
                 return None;
             }
-            m = m.min(min3(angles(&c)));
+            m = m.min(min_angle_key(&c));
         }
         Some(m)
     }
@@ -199,9 +233,10 @@ impl Smoother<'_> {
             return 0.0;
         }
         let scale = len / cnt;
+        let mut tied: Vec<(f64, [f64; 3])> = Vec::with_capacity(8);
         let mut grads: Vec<[f64; 3]> = Vec::with_capacity(8);
         for _ in 0..o.max_node_iterations {
-            grads.clear();
+            tied.clear();
             for &t in self.cluster(v as usize) {
                 let c = self.corners_at(t, v, x);
                 let k = self.m.triangles[t as usize]
@@ -209,17 +244,24 @@ impl Smoother<'_> {
                     .position(|&u| u == v)
                     .unwrap_or(0);
                 let a = angles(&c);
+                let lim = key_angle(phi) + tol;
                 for (j, &aj) in a.iter().enumerate() {
-                    if aj <= phi + tol {
+                    if aj <= lim {
                         let g = angle_gradient(&c, j, k);
-                        grads.push(match motion {
-                            Motion::Slide(d) => [g[0] * d[0] + g[1] * d[1], 0.0, 0.0],
-                            _ => [g[0], g[1], 0.0],
-                        });
+                        tied.push((
+                            aj,
+                            match motion {
+                                Motion::Slide(d) => [g[0] * d[0] + g[1] * d[1], 0.0, 0.0],
+                                _ => [g[0], g[1], 0.0],
+                            },
+                        ));
                     }
                 }
             }
             // The tied angles nearest the minimum first (min_norm_point uses a bounded number).
+            tied.sort_by(|a, b| a.0.total_cmp(&b.0));
+            grads.clear();
+            grads.extend(tied.iter().map(|t| t.1));
             let d3 = min_norm_point(&grads);
             let d = match motion {
                 Motion::Slide(s) => [d3[0] * s[0], d3[0] * s[1]],
@@ -229,7 +271,14 @@ impl Smoother<'_> {
             if dn.is_nan() || dn <= 1e-12 / scale {
                 break;
             }
-            let mut h = o.step_fraction * scale / dn;
+            // The first trial: a fraction of the node's edges, or a few times its last step.
+            let last = self.last[v as usize];
+            let len0 = if last > 0.0 {
+                (4.0 * last).min(o.step_fraction * scale)
+            } else {
+                o.step_fraction * scale
+            };
+            let mut h = len0 / dn;
             let mut accepted = false;
             for _ in 0..=o.max_halvings {
                 let y = [x[0] + h * d[0], x[1] + h * d[1]];
@@ -239,6 +288,7 @@ impl Smoother<'_> {
                     x = y;
                     phi = p;
                     accepted = true;
+                    self.last[v as usize] = h * dn;
                     break;
                 }
                 h *= 0.5;
@@ -348,6 +398,7 @@ pub fn smooth_tri_with_segments(
     };
     report.min_angle_before_deg = mesh_min(mesh);
     let mut s = Smoother {
+        last: vec![0.0; n],
         m: mesh,
         start,
         star,
@@ -361,7 +412,7 @@ pub fn smooth_tri_with_segments(
         let mut order: Vec<(f64, u32)> = (0..n as u32)
             .filter(|&v| dirty[v as usize] && !matches!(motion[v as usize], Motion::Fixed))
             .filter_map(|v| s.phi(v, s.m.points[v as usize]).map(|p| (p, v)))
-            .filter(|&(p, _)| p < skip)
+            .filter(|&(p, _)| key_angle(p) < skip)
             .collect();
         order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         dirty.iter_mut().for_each(|d| *d = false);
