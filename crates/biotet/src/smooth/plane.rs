@@ -142,6 +142,26 @@ fn min_angle_key(c: &[[f64; 2]; 3]) -> f64 {
     }
 }
 
+/// The keys (−cos) of the three angles, in corner order.
+fn corner_keys(c: &[[f64; 2]; 3]) -> [f64; 3] {
+    let d = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2);
+    let l = [d(c[1], c[2]), d(c[2], c[0]), d(c[0], c[1])];
+    let mut k = [0.0; 3];
+    for (i, ki) in k.iter_mut().enumerate() {
+        let p = c[i];
+        let a = c[(i + 1) % 3];
+        let b = c[(i + 2) % 3];
+        let dot = (a[0] - p[0]) * (b[0] - p[0]) + (a[1] - p[1]) * (b[1] - p[1]);
+        let den = (l[(i + 2) % 3] * l[(i + 1) % 3]).sqrt();
+        *ki = if den > 0.0 {
+            -(dot / den).clamp(-1.0, 1.0)
+        } else {
+            -1.0
+        };
+    }
+    k
+}
+
 /// The angle of a key of [`min_angle_key`].
 fn key_angle(k: f64) -> f64 {
     (-k).clamp(-1.0, 1.0).acos()
@@ -237,15 +257,15 @@ impl Smoother<'_> {
         let mut grads: Vec<[f64; 3]> = Vec::with_capacity(8);
         for _ in 0..o.max_node_iterations {
             tied.clear();
+            // Active angles: within `tol` of the minimum, i.e. a key (−cos) below this.
+            let lim = -(key_angle(phi) + tol).min(std::f64::consts::PI).cos();
             for &t in self.cluster(v as usize) {
                 let c = self.corners_at(t, v, x);
                 let k = self.m.triangles[t as usize]
                     .iter()
                     .position(|&u| u == v)
                     .unwrap_or(0);
-                let a = angles(&c);
-                let lim = key_angle(phi) + tol;
-                for (j, &aj) in a.iter().enumerate() {
+                for (j, aj) in corner_keys(&c).into_iter().enumerate() {
                     if aj <= lim {
                         let g = angle_gradient(&c, j, k);
                         tied.push((
