@@ -466,15 +466,30 @@ pub fn carve(mesh: &mut TriMesh, pslg: &Pslg) -> Result<CarveReport, CarveError>
     let mut report = CarveReport::default();
     let mut tris = Vec::with_capacity(nt);
     let mut labels = Vec::with_capacity(nt);
+    let mut new_index = vec![NO_NEIGHBOR; nt];
     for t in 0..nt {
         let l = label[part[t] as usize].unwrap_or(0);
         if l == 0 {
             report.n_removed += 1;
         } else {
+            new_index[t] = tris.len() as u32;
             tris.push(mesh.triangles[t]);
             labels.push(l);
         }
     }
+    // Adjacency carried over: kept triangles keep their kept neighbours.
+    let neighbors: Vec<[u32; 3]> = (0..nt)
+        .filter(|&t| new_index[t] != NO_NEIGHBOR)
+        .map(|t| {
+            mesh.neighbors[t].map(|n| {
+                if n == NO_NEIGHBOR {
+                    NO_NEIGHBOR
+                } else {
+                    new_index[n as usize]
+                }
+            })
+        })
+        .collect();
     if tris.is_empty() {
         return Err(CarveError::Empty);
     }
@@ -502,7 +517,12 @@ pub fn carve(mesh: &mut TriMesh, pslg: &Pslg) -> Result<CarveReport, CarveError>
     for tv in &mut tris {
         *tv = tv.map(|v| map[v as usize]);
     }
-    *mesh = TriMesh::new(points, tris, labels);
+    *mesh = TriMesh {
+        points,
+        triangles: tris,
+        neighbors,
+        labels,
+    };
     report.point_map = map;
     Ok(report)
 }

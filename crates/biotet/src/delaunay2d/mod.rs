@@ -408,6 +408,12 @@ impl Delaunay2d {
     /// The finite triangles as a [`TriMesh`] (label 1, hull edges without neighbour), in slot
     /// order: deterministic for given points.
     pub fn to_tri_mesh(&self) -> TriMesh {
+        let mut m = self.tri_mesh_without_points();
+        m.points = self.points.clone();
+        m
+    }
+
+    fn tri_mesh_without_points(&self) -> TriMesh {
         let mut index = vec![NO_NEIGHBOR; self.tri.len()];
         let mut triangles = Vec::new();
         for t in self.finite() {
@@ -419,7 +425,7 @@ impl Delaunay2d {
             .map(|t| self.nbr[t].map(|n| index[n as usize]))
             .collect();
         TriMesh {
-            points: self.points.clone(),
+            points: Vec::new(),
             labels: vec![1; triangles.len()],
             triangles,
             neighbors,
@@ -428,7 +434,7 @@ impl Delaunay2d {
 
     /// Consume the triangulation into a [`TriMesh`] (see [`Delaunay2d::to_tri_mesh`]).
     pub fn into_tri_mesh(self) -> TriMesh {
-        let mut m = self.to_tri_mesh();
+        let mut m = self.tri_mesh_without_points();
         m.points = self.points;
         m
     }
