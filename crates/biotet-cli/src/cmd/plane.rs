@@ -217,6 +217,13 @@ pub fn recover_cmd(
 ) -> Result<ExitCode> {
     let stage = Stage::start(common.quiet, format!("reading {}", mesh_path.display()));
     let mut mesh = read_tri(mesh_path, common)?;
+    let valid = check_tri(&mesh, None);
+    if !valid.valid {
+        anyhow::bail!(
+            "{}: not a valid triangulation, cannot recover segments in it:\n{valid}",
+            mesh_path.display()
+        );
+    }
     let mut pslg = read_pslg(pslg_path)?;
     let map = points_in_mesh(&mesh, &pslg, pslg_path, mesh_path)?;
     let segs: Vec<[u32; 2]> = pslg
