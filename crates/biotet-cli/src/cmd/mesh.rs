@@ -33,7 +33,8 @@ pub struct Args {
     /// Closed surfaces (.stl, .obj, .off, .ply, .mesh, .vtu). Every closed shell encloses a
     /// region; a point belongs to the innermost shell around it. Shells are labelled 1, 2, … in
     /// order of files and of shells within a file, unless --label says otherwise. Without a
-    /// surface, the bundled brain example is meshed.
+    /// surface, the bundled brain example is meshed. A 2D planar straight-line graph (.poly,
+    /// .node/.edge, or a Dimension 2 .mesh with Edges) is meshed in 2D (see README "2D meshes").
     surfaces: Vec<PathBuf>,
     /// Labels of one file's shells in order, as FILE=N[,N...] (repeatable); 0 makes a shell a
     /// cavity (not meshed).

@@ -320,3 +320,56 @@ fn table_4_1_fixed_and_sliding() {
     assert!(rs.min_angle_after_deg > 20.0, "{rs:?}");
     assert_eq!(min_angle(&slid), rs.min_angle_after_deg);
 }
+
+#[test]
+fn recovery_failures_are_reported_not_hidden() {
+    use biotet::recover2d::{SegmentFailure, recover};
+    // Node 4 lies on the segment 0–2: no triangulation without a node on it contains it.
+    let pts = vec![
+        [0.0, 0.0],
+        [2.0, 0.0],
+        [2.0, 2.0],
+        [0.0, 2.0],
+        [1.0, 1.0],
+        [1.5, 0.2],
+    ];
+    let mut m = triangulate(pts).unwrap();
+    let before = m.clone();
+    let r = recover(&mut m, &[[0, 2], [1, 3]]);
+    assert_eq!(
+        r.failed,
+        vec![
+            SegmentFailure::NodeOnSegment {
+                segment: 0,
+                node: 4
+            },
+            SegmentFailure::NodeOnSegment {
+                segment: 1,
+                node: 4
+            }
+        ]
+    );
+    assert_eq!(m, before, "nothing changed");
+    // An L-shaped mesh: the segment between the arms' tips leaves the domain.
+    let l = TriMesh::new(
+        vec![
+            [0.0, 0.0],
+            [2.0, 0.0],
+            [2.0, 1.0],
+            [1.0, 1.0],
+            [1.0, 2.0],
+            [0.0, 2.0],
+        ],
+        vec![[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 5]],
+        vec![1; 4],
+    );
+    assert!(check_tri(&l, None).valid);
+    let mut m = l.clone();
+    let r = recover(&mut m, &[[2, 4], [1, 5]]);
+    assert_eq!(r.failed.len(), 2);
+    assert!(matches!(
+        r.failed[0],
+        SegmentFailure::LeavesMesh { segment: 0 }
+    ));
+    assert!(check_tri(&m, None).valid);
+}
