@@ -233,25 +233,31 @@ impl Work<'_> {
         Ok(Some(carved.len()))
     }
 
-    /// Triangulate the polygon `p, chain..., q` lying left of `p → q` (Delaunay in the polygon).
+    /// Triangulate the polygon `p, chain..., q` lying left of `p → q` (Delaunay in the polygon):
+    /// on base `pq`, the chain node `c` whose circle through `p, q` holds no other chain node
+    /// (one pass: circles through `p, q` on one side are nested), then the sub-polygons on `pc`
+    /// and `cq` (an explicit stack, so long chains cannot overflow the call stack).
     fn fill(&self, p: u32, q: u32, chain: &[u32], out: &mut Vec<[u32; 3]>) {
-        if chain.is_empty() {
-            return;
-        }
-        let mut c = 0;
-        for d in 1..chain.len() {
-            let (cv, dv) = (chain[c], chain[d]);
-            if incircle_sos(
-                [self.p(p), self.p(q), self.p(cv), self.p(dv)],
-                [p, q, cv, dv],
-            ) == Sign::Positive
-            {
-                c = d;
+        let mut todo: Vec<(u32, u32, usize, usize)> = vec![(p, q, 0, chain.len())];
+        while let Some((p, q, lo, hi)) = todo.pop() {
+            if lo >= hi {
+                continue;
             }
+            let mut c = lo;
+            for d in lo + 1..hi {
+                let (cv, dv) = (chain[c], chain[d]);
+                if incircle_sos(
+                    [self.p(p), self.p(q), self.p(cv), self.p(dv)],
+                    [p, q, cv, dv],
+                ) == Sign::Positive
+                {
+                    c = d;
+                }
+            }
+            out.push([p, q, chain[c]]);
+            todo.push((chain[c], q, c + 1, hi));
+            todo.push((p, chain[c], lo, c));
         }
-        out.push([p, q, chain[c]]);
-        self.fill(p, chain[c], &chain[..c], out);
-        self.fill(chain[c], q, &chain[c + 1..], out);
     }
 
     /// Put `new` in the slots of `carved` and relink adjacency.

@@ -373,3 +373,55 @@ fn recovery_failures_are_reported_not_hidden() {
     ));
     assert!(check_tri(&m, None).valid);
 }
+
+#[test]
+fn long_segment_across_a_cocircular_lattice() {
+    // The square [0, 40]² with a node at every integer point of its boundary, the interior
+    // lattice as free nodes (every lattice square cocircular), and one internal segment between
+    // two extra points that crosses the whole lattice without touching a lattice point
+    // (304x − 390y = 35 has no integer solution).
+    let mut points = Vec::new();
+    for s in 0..4 {
+        for i in 0..40 {
+            let t = f64::from(i);
+            points.push(match s {
+                0 => [t, 0.0],
+                1 => [40.0, t],
+                2 => [40.0 - t, 40.0],
+                _ => [0.0, 40.0 - t],
+            });
+        }
+    }
+    let mut segments: Vec<[u32; 2]> = (0..160).map(|i| [i, (i + 1) % 160]).collect();
+    points.push([0.5, 0.3]);
+    points.push([39.5, 30.7]);
+    segments.push([160, 161]);
+    let g = Pslg {
+        points,
+        segment_markers: vec![0; segments.len()],
+        segments,
+        ..Default::default()
+    };
+    let nodes: Vec<[f64; 2]> = (1..40)
+        .flat_map(|y| (1..40).map(move |x| [f64::from(x), f64::from(y)]))
+        .collect();
+    let (m, rep) = triangulate_pslg(&g, &nodes).unwrap();
+    assert_eq!(rep.recover.n_recovered, 1);
+    assert!(rep.recover.n_carved > 60, "{:?}", rep.recover);
+    let c = check_tri(&m, Some(&g));
+    assert!(c.valid, "{c}");
+    assert_eq!(
+        c.pslg.unwrap().sides,
+        vec![
+            biotet::check2d::SegmentSides {
+                labels: [0, 1],
+                count: 160
+            },
+            biotet::check2d::SegmentSides {
+                labels: [1, 1],
+                count: 1
+            },
+        ]
+    );
+    assert_eq!(m.points.len(), 162 + 39 * 39);
+}
