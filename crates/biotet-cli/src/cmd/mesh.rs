@@ -136,6 +136,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
                     ZoneArg::Euclidean => Zone::Euclidean,
                 },
                 max_pixels: a.max_voxels,
+                grading: a.grading,
                 no_smooth: a.no_smooth,
                 no_deploy: a.no_deploy,
                 svg: a.svg.as_deref(),

@@ -80,6 +80,8 @@ pub struct MeshArgs<'a> {
     pub zone: Zone,
     /// Template limit.
     pub max_pixels: usize,
+    /// Size growth per unit distance from the boundary.
+    pub grading: f64,
     /// Skip smoothing.
     pub no_smooth: bool,
     /// Skip node deployment (the PSLG's own points only).
@@ -99,6 +101,7 @@ pub fn mesh(a: MeshArgs, common: Common) -> Result<ExitCode> {
             resolution: a.resolution,
             zone: a.zone,
             max_pixels: a.max_pixels,
+            grading: Some(a.grading),
         },
         smooth: (!a.no_smooth).then(PlaneSmoothOptions::default),
     };

@@ -19,7 +19,9 @@
 //!    region within that size on either side (a trapezoid, vertex-dependent widths) is marked
 //!    buffer.
 //! 5. **Inward sweep** (fig. 2.9): breadth-first from the buffer, each unprocessed inside pixel
-//!    becomes a node and claims its zone.
+//!    becomes a node and claims its zone — of the interior size, or with
+//!    [`PlaneDeployOptions::grading`] of a size growing from the boundary points' sizes by that
+//!    rate per unit distance (a chamfer distance field over the pixels), up to the interior size.
 
 use serde::Serialize;
 
@@ -41,6 +43,9 @@ pub struct PlaneDeployOptions {
     pub zone: Zone,
     /// Refuse templates with more pixels than this.
     pub max_pixels: usize,
+    /// Grading: the size grows from each PSLG point's size by this much per unit of distance, up
+    /// to `size` (`None`: `size` everywhere away from the boundary buffer).
+    pub grading: Option<f64>,
 }
 
 impl Default for PlaneDeployOptions {
@@ -50,8 +55,62 @@ impl Default for PlaneDeployOptions {
             resolution: 2.0,
             zone: Zone::Euclidean,
             max_pixels: 1 << 31,
+            grading: None,
         }
     }
+}
+
+/// The graded size at every pixel: `min(h, min_i(s_i + g·d(pixel, x_i)))` over the PSLG points,
+/// with `d` the 3×3 chamfer distance (steps 1 and √2 pixels, within 8% of Euclidean) computed in
+/// two raster passes — a sizing field, so floating point.
+fn graded_field(t: &Template, seeds: &[([usize; 3], f64)], h: f64, g: f64) -> Vec<f32> {
+    let [nx, ny, _] = t.n;
+    let mut f = vec![f32::INFINITY; nx * ny];
+    for &(c, s) in seeds {
+        let i = c[0] + nx * c[1];
+        f[i] = f[i].min(s as f32);
+    }
+    let a = (g * t.dx) as f32;
+    let b = a * std::f32::consts::SQRT_2;
+    for j in 0..ny {
+        for i in 0..nx {
+            let k = i + nx * j;
+            let mut v = f[k];
+            if i > 0 {
+                v = v.min(f[k - 1] + a);
+            }
+            if j > 0 {
+                v = v.min(f[k - nx] + a);
+                if i > 0 {
+                    v = v.min(f[k - nx - 1] + b);
+                }
+                if i + 1 < nx {
+                    v = v.min(f[k - nx + 1] + b);
+                }
+            }
+            f[k] = v;
+        }
+    }
+    for j in (0..ny).rev() {
+        for i in (0..nx).rev() {
+            let k = i + nx * j;
+            let mut v = f[k];
+            if i + 1 < nx {
+                v = v.min(f[k + 1] + a);
+            }
+            if j + 1 < ny {
+                v = v.min(f[k + nx] + a);
+                if i + 1 < nx {
+                    v = v.min(f[k + nx + 1] + b);
+                }
+                if i > 0 {
+                    v = v.min(f[k + nx - 1] + b);
+                }
+            }
+            f[k] = v.min(h as f32);
+        }
+    }
+    f
 }
 
 /// Figures of one deployment.
@@ -260,9 +319,27 @@ pub fn deploy_plane(
         ];
         mark_convex(&mut t, &quad);
     }
-    // 5. Inward sweep.
+    // 5. Inward sweep, with the graded size when asked.
     let r = radius(h);
-    stats.interior_nodes = sweep(&mut t, opts.zone, &|_, _| r);
+    stats.interior_nodes = match opts.grading {
+        Some(g) if g > 0.0 && g.is_finite() => {
+            let seeds: Vec<([usize; 3], f64)> = pslg
+                .points
+                .iter()
+                .zip(&size)
+                .map(|(p, &s)| (t.nearest([p[0], p[1], 0.0]), s))
+                .collect();
+            let field = graded_field(&t, &seeds, h, g);
+            let (nx, o, dx) = (t.n[0], t.origin, t.dx);
+            let at = move |p: [f64; 3], _: u32| {
+                let i = ((p[0] - o[0]) / dx).round() as usize;
+                let j = ((p[1] - o[1]) / dx).round() as usize;
+                radius(f64::from(field[i + nx * j]))
+            };
+            sweep(&mut t, opts.zone, &at)
+        }
+        _ => sweep(&mut t, opts.zone, &|_, _| r),
+    };
     let mut nodes = Vec::with_capacity(stats.interior_nodes);
     for idx in 0..t.cells.len() {
         if t.state(idx) == INTERIOR_NODE {

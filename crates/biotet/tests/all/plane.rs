@@ -425,3 +425,26 @@ fn long_segment_across_a_cocircular_lattice() {
     );
     assert_eq!(m.points.len(), 162 + 39 * 39);
 }
+
+#[test]
+fn graded_deployment_between_fine_boundary_and_coarse_inside() {
+    let g = subdivided(&holey_pslg(), 0.25);
+    let run = |size: f64, grading: Option<f64>| {
+        let opts = Mesh2dOptions {
+            deploy: PlaneDeployOptions {
+                size: Some(size),
+                grading,
+                ..Default::default()
+            },
+            smooth: None,
+        };
+        let (m, rep) = mesh_pslg(&g, &opts).unwrap();
+        let c = check_tri(&m, Some(&g));
+        assert!(c.valid, "{c}");
+        rep.template.unwrap().interior_nodes
+    };
+    let coarse = run(1.0, None);
+    let graded = run(1.0, Some(0.3));
+    let fine = run(0.25, None);
+    assert!(coarse < graded && graded < fine, "{coarse} {graded} {fine}");
+}
