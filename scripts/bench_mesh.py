@@ -14,65 +14,22 @@ routine for all tools: `biotet quality --json` on each output; missing input tri
 --scaling meshes the first surface at several uniform sizes with the deployment stages only (template, Delaunay,
 outside removal; `--no-recover --no-improve --no-smooth`) and prints seconds per tet (dissertation fig. 2.16).
 """
-import argparse, json, os, shutil, statistics, subprocess, sys, tempfile, textwrap, time
+import argparse, json, os, shutil, subprocess, sys, tempfile, time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BIOTET = os.path.join(ROOT, "target", "release", "biotet")
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import benchlib  # noqa: E402  (shared: the biotet calls, the one quality routine, the pip TetGen child)
+from benchlib import ROOT, median as med  # noqa: E402
+
+BIOTET = benchlib.find_biotet()
 DEFAULT = [os.path.join(ROOT, "tests", "data", "brain_20k.stl")]
-
-PIP_TETGEN = textwrap.dedent(r'''
-    import json, resource, sys, time
-    import numpy as np, meshio, tetgen
-    surface, switches, node = sys.argv[1], sys.argv[2], sys.argv[3]
-    m = meshio.read(surface)
-    p = np.asarray(m.points, dtype=float)
-    t = np.asarray(m.cells_dict["triangle"], dtype=np.int32)
-    # STL repeats each corner: weld exactly equal points as every mesher does.
-    p, inv = np.unique(p, axis=0, return_inverse=True)
-    t = inv.reshape(-1)[t]
-    def rss_kb():
-        with open("/proc/self/status") as f:
-            for line in f:
-                if line.startswith("VmRSS"):
-                    return int(line.split()[1])
-    before = rss_kb()
-    g = tetgen.TetGen(p, t)
-    start = time.perf_counter()
-    res = g.tetrahedralize(switches=switches)
-    seconds = time.perf_counter() - start
-    nodes, elems = res[0], res[1]
-    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    with open(node + ".node", "w") as f:
-        f.write(f"{len(nodes)} 3 0 0\n")
-        for i, q in enumerate(nodes):
-            f.write(f"{i} {float(q[0])!r} {float(q[1])!r} {float(q[2])!r}\n")
-    with open(node + ".ele", "w") as f:
-        f.write(f"{len(elems)} 4 0\n")
-        for i, e in enumerate(elems):
-            f.write(f"{i} {e[0]} {e[1]} {e[2]} {e[3]}\n")
-    print(json.dumps({"seconds": seconds, "rss_before_kb": before, "peak_rss_kb": peak}))
-''')
 
 
 def biotet_json(*args):
-    r = subprocess.run([BIOTET, *args, "--json"], capture_output=True, text=True)
-    if r.returncode not in (0, 1):
-        raise RuntimeError(f"biotet {' '.join(args)}: {r.stderr.strip()}")
-    return json.loads(r.stdout)
+    return benchlib.biotet_json(BIOTET, *args)
 
 
 def measure(mesh, surface):
-    q = biotet_json("quality", mesh)
-    c = biotet_json("check", mesh, "--surface", surface)
-    conf = c.get("surface") or {}
-    return {
-        "points": q.get("n_points"), "tets": q.get("n_tets"),
-        "min_dihedral": q.get("min_dihedral_deg"), "max_dihedral": q.get("max_dihedral_deg"),
-        "min_solid_sr": q.get("min_solid_angle_sr"), "mean_q": q.get("mean_q"),
-        "lt5": q.get("n_dihedral_lt_5"), "lt10": q.get("n_dihedral_lt_10"), "lt20": q.get("n_dihedral_lt_20"),
-        "missing": (conf.get("n_triangles", 0) - conf.get("n_found", 0)) if conf else None,
-        "valid": c.get("valid"),
-    }
+    return benchlib.measure(BIOTET, mesh, surface)
 
 
 def run_biotet(surface, out, extra, repeat):
@@ -89,14 +46,11 @@ def run_biotet(surface, out, extra, repeat):
 def run_pip_tetgen(surface, switches, base, repeat):
     rows = []
     for _ in range(repeat):
-        start = time.perf_counter()
-        r = subprocess.run([sys.executable, "-c", PIP_TETGEN, surface, switches, base],
-                           capture_output=True, text=True)
-        wall = time.perf_counter() - start
-        if r.returncode != 0:
-            return None, (r.stderr.strip().splitlines() or ["failed"])[-1]
-        j = json.loads(r.stdout.strip().splitlines()[-1])
-        rows.append({"seconds": j["seconds"], "wall": wall, "mem_kb": j["peak_rss_kb"] - j["rss_before_kb"]})
+        try:
+            j = benchlib.run_child("tetgen", surface, base, switches=switches)
+        except RuntimeError as e:
+            return None, str(e)
+        rows.append({"seconds": j["seconds"], "wall": j["wall"], "mem_kb": j["peak_rss_kb"] - j["rss_before_kb"]})
     return rows, None
 
 
@@ -123,11 +77,6 @@ def run_tetgen_binary(surface, switches, tmp, repeat):
         rows.append({"seconds": float(sec.group(1)) if sec else wall, "wall": wall,
                      "mem_kb": int(peak.group(1)) if peak else None})
     return rows, None, os.path.join(tmp, "tg_input.1.node")
-
-
-def med(rows, key):
-    vals = [r[key] for r in rows if r.get(key) is not None]
-    return statistics.median(vals) if vals else None
 
 
 def fmt(v, spec):

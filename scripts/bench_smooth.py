@@ -16,31 +16,16 @@ Set BIOTET to the binary if it is not target/release/biotet.
 """
 import argparse, json, os, shutil, statistics, subprocess, sys, tempfile, time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BIOTET = os.environ.get("BIOTET", os.path.join(ROOT, "target", "release", "biotet"))
-DEFAULT = os.path.join(ROOT, "tests", "data", "brain_20k.stl")
-
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from bench_mesh import PIP_TETGEN  # noqa: E402  (the pip TetGen child: meshes, writes .node/.ele, prints its seconds)
+import benchlib  # noqa: E402  (shared: the biotet calls, the pip TetGen child, MMG's binary)
+from benchlib import ROOT, mmg3d  # noqa: E402
 
-
-def mmg3d():
-    """The mmg3d binary: pymmg installs mmg3d_O3 inside its package directory and a wrapper on PATH."""
-    try:
-        import mmg3d as pkg  # pymmg's package
-        exe = os.path.join(os.path.dirname(pkg.__file__), "mmg3d_O3")
-        if os.path.exists(exe):
-            return exe
-    except ImportError:
-        pass
-    return shutil.which("mmg3d_O3") or shutil.which("mmg3d")
+BIOTET = benchlib.find_biotet()
+DEFAULT = os.path.join(ROOT, "tests", "data", "brain_20k.stl")
 
 
 def biotet_json(*args):
-    r = subprocess.run([BIOTET, *args, "--json"], capture_output=True, text=True)
-    if r.returncode != 0:
-        raise RuntimeError(f"biotet {' '.join(args)}: {r.stderr.strip()}")
-    return json.loads(r.stdout)
+    return benchlib.biotet_json(BIOTET, *args, ok=(0,))
 
 
 def measure(mesh):
@@ -60,13 +45,8 @@ def measure(mesh):
 
 
 def tetgen(surface, switches, out, repeat):
-    times = []
-    for _ in range(repeat):
-        r = subprocess.run([sys.executable, "-c", PIP_TETGEN, surface, switches, out], capture_output=True, text=True)
-        if r.returncode != 0:
-            raise RuntimeError(f"tetgen {switches}: {r.stderr.strip()}")
-        times.append(json.loads(r.stdout.strip().splitlines()[-1])["seconds"])
-    return statistics.median(times)
+    return statistics.median(
+        benchlib.run_child("tetgen", surface, out, switches=switches)["seconds"] for _ in range(repeat))
 
 
 def main():

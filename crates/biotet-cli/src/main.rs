@@ -3,7 +3,8 @@
 //! Conventions shared by every command: `biotet <command> INPUT... [-o OUT]`, `--help`
 //! everywhere, `--quiet` silences everything but errors, `--json` prints one JSON object on
 //! stdout for scripts, a progress spinner on a terminal, errors as one message without a
-//! backtrace, outputs written to a temporary file and renamed.
+//! backtrace, outputs written to a temporary file and renamed, `--threads N` for the parallel
+//! stages (all cores by default; no result depends on it).
 
 mod cmd;
 mod plot;
@@ -18,6 +19,10 @@ use std::process::ExitCode;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Worker threads for the parallel stages (smoothing sweeps, surface validation); 0 or
+    /// absent: one per core. Results do not depend on it.
+    #[arg(long, global = true, value_name = "N")]
+    threads: Option<usize>,
 }
 
 /// Options every command takes.
@@ -80,6 +85,14 @@ fn main() -> ExitCode {
         default_hook(info);
     }));
     let cli = Cli::parse();
+    if let Some(n) = cli.threads
+        && let Err(e) = rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+    {
+        eprintln!("error: --threads {n}: {e}");
+        return ExitCode::from(EXIT_ERROR);
+    }
     let json = std::env::args().any(|a| a == "--json");
     let result = match cli.command {
         Command::Quality(a) => cmd::quality::run(a),
@@ -103,7 +116,9 @@ fn main() -> ExitCode {
             // A surface refused by validation is an invalid input, not a failure to run.
             let refused = e
                 .downcast_ref::<biotet::mesh::validate::SurfaceError>()
-                .is_some();
+                .is_some()
+                || e.downcast_ref::<biotet::mesh::side_labels::SideLabelError>()
+                    .is_some();
             ExitCode::from(if refused { EXIT_INVALID } else { EXIT_ERROR })
         }
     }

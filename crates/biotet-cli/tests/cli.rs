@@ -113,6 +113,65 @@ fn quality_of_the_bundled_example() {
 }
 
 #[test]
+fn quality_with_the_surface_splits_by_placement_and_counts_forced_tets() {
+    let plain = json_of(&biotet(&["quality", s(&example()), "--json"]));
+    let j = json_of(&biotet(&[
+        "quality",
+        s(&example()),
+        "--surface",
+        s(&brain_surface()),
+        "--json",
+    ]));
+    // The report itself is unchanged; the split is added beside it.
+    for k in QUALITY_KEYS {
+        assert_eq!(j[k], plain[k], "{k}");
+    }
+    let place = &j["placement"];
+    let count = |class: &str, key: &str| place[class][key].as_u64().unwrap();
+    let classes = ["face", "vertex", "interior"];
+    // Every tet is in one class, and each class's poor tets add up to the whole mesh's.
+    for (key, total) in [
+        ("n_tets", "n_tets"),
+        ("n_dihedral_lt_5", "n_dihedral_lt_5"),
+        ("n_dihedral_lt_10", "n_dihedral_lt_10"),
+        ("n_dihedral_lt_20", "n_dihedral_lt_20"),
+    ] {
+        let sum: u64 = classes.iter().map(|c| count(c, key)).sum();
+        assert_eq!(sum, j[total].as_u64().unwrap(), "{key}");
+    }
+    // TetGen -Y keeps all 19,648 input triangles as faces, each of one tet (the closed surface
+    // bounds one side), a tet holding at most three of them.
+    let face = count("face", "n_tets");
+    assert!(face <= 19648 && 3 * face >= 19648, "{face}");
+    // The marching-cubes triangles force poor tets, all of them on the surface.
+    let forced = j["n_forced"].as_u64().unwrap();
+    assert!(forced > 1000, "{forced}");
+    assert_eq!(
+        forced,
+        classes.iter().map(|c| count(c, "n_forced")).sum::<u64>()
+    );
+    assert_eq!(count("interior", "n_forced"), 0);
+    assert_eq!(j["forcing"]["n_forced"], j["n_forced"]);
+    let unforced = j["n_unforced_dihedral_lt_10"].as_u64().unwrap();
+    let lt10 = j["n_dihedral_lt_10"].as_u64().unwrap();
+    assert!(unforced > 0 && unforced < lt10, "{unforced} of {lt10}");
+    // The smallest dihedral angle of the mesh is the smallest of the classes'.
+    let min_of = |c: &str| place[c]["min_dihedral_deg"].as_f64().unwrap();
+    let m = classes
+        .iter()
+        .map(|c| min_of(c))
+        .fold(f64::INFINITY, f64::min);
+    assert_eq!(m, j["min_dihedral_deg"].as_f64().unwrap());
+    // The text report says the same.
+    let text = biotet(&["quality", s(&example()), "-s", s(&brain_surface())]);
+    let text = String::from_utf8_lossy(&text.stdout);
+    assert!(
+        text.contains("by placement") && text.contains(&format!("{forced} tets")),
+        "{text}"
+    );
+}
+
+#[test]
 fn the_bundled_example_passes_the_checker_with_its_surface() {
     let out = biotet(&[
         "check",
@@ -867,4 +926,252 @@ print(sorted(labels))
             o.display()
         );
     }
+}
+
+/// Two unit cubes touching along x = 1 (regions 2 and 3) inside the box [-1, 3] x [-1, 2]²
+/// (region 1), as one non-manifold surface with the labels of both sides of every triangle:
+/// ASCII PLY with `label_back` and `label_front`. The shared square's edges are triple lines.
+fn three_regions_ply() -> String {
+    let mut pts: Vec<[f64; 3]> = Vec::new();
+    let mut tris: Vec<([usize; 3], [u32; 2])> = Vec::new();
+    let mut add_box = |lo: [f64; 3], hi: [f64; 3], sides: [u32; 2]| {
+        for d in 0..3 {
+            let (u, v) = ((d + 1) % 3, (d + 2) % 3);
+            for (at, outward) in [(lo[d], false), (hi[d], true)] {
+                let corner = |a: f64, b: f64| {
+                    let mut p = [0.0; 3];
+                    (p[d], p[u], p[v]) = (at, a, b);
+                    p
+                };
+                let mut q = [
+                    corner(lo[u], lo[v]),
+                    corner(hi[u], lo[v]),
+                    corner(hi[u], hi[v]),
+                    corner(lo[u], hi[v]),
+                ];
+                if !outward {
+                    q.reverse();
+                }
+                // Split along the diagonal through the smallest corner, so touching boxes agree.
+                let k = (0..4)
+                    .min_by(|&i, &j| q[i].partial_cmp(&q[j]).unwrap())
+                    .unwrap();
+                let id: Vec<usize> = (0..4)
+                    .map(|i| {
+                        let p = q[(k + i) % 4];
+                        pts.iter().position(|x| *x == p).unwrap_or_else(|| {
+                            pts.push(p);
+                            pts.len() - 1
+                        })
+                    })
+                    .collect();
+                for t in [[id[0], id[1], id[2]], [id[0], id[2], id[3]]] {
+                    let mut key = t;
+                    key.sort_unstable();
+                    let shared = tris.iter().position(|(x, _)| {
+                        let mut k2 = *x;
+                        k2.sort_unstable();
+                        k2 == key
+                    });
+                    match shared {
+                        // Given by the other cube: its front is this cube.
+                        Some(i) => tris[i].1[1] = sides[0],
+                        None => tris.push((t, sides)),
+                    }
+                }
+            }
+        }
+    };
+    add_box([0.0; 3], [1.0; 3], [2, 1]);
+    add_box([1.0, 0.0, 0.0], [2.0, 1.0, 1.0], [3, 1]);
+    add_box([-1.0; 3], [3.0, 2.0, 2.0], [1, 0]);
+    let mut out = format!(
+        "ply\nformat ascii 1.0\nelement vertex {}\nproperty double x\nproperty double y\n\
+         property double z\nelement face {}\nproperty list uchar int vertex_indices\n\
+         property int label_back\nproperty int label_front\nend_header\n",
+        pts.len(),
+        tris.len()
+    );
+    for p in &pts {
+        out += &format!("{} {} {}\n", p[0], p[1], p[2]);
+    }
+    for (t, l) in &tris {
+        out += &format!("3 {} {} {} {} {}\n", t[0], t[1], t[2], l[0], l[1]);
+    }
+    out
+}
+
+#[test]
+fn a_labelled_non_manifold_surface_meshes_from_ply_vtu_and_medit() {
+    let dir = tempfile::tempdir().unwrap();
+    let ply = dir.path().join("three.ply");
+    std::fs::write(&ply, three_regions_ply()).unwrap();
+    // The same labelled surface as VTU (`sides`) and Medit (refs, interfaces twice).
+    let vtu = dir.path().join("three.vtu");
+    let medit = dir.path().join("three.mesh");
+    for o in [&vtu, &medit] {
+        let out = biotet(&["convert", s(&ply), "-o", s(o)]);
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    let v = biotet(&["validate", s(&vtu), "--json"]);
+    assert!(v.status.success(), "{}", stderr(&v));
+    let mut tet_counts = Vec::new();
+    for input in [&ply, &vtu, &medit] {
+        let out = dir.path().join("m.vtu");
+        let j = json_of(&biotet(&[
+            "mesh",
+            s(input),
+            "--size",
+            "0.5",
+            "-o",
+            s(&out),
+            "--json",
+        ]));
+        assert_eq!(j["pipeline"]["missing_triangles"], 0, "{j}");
+        let regions = j["quality"]["regions"].as_array().unwrap();
+        let vol = |l: u64| {
+            regions.iter().find(|r| r["label"] == l).unwrap()["volume"]
+                .as_f64()
+                .unwrap()
+        };
+        // Each region's volume is what its surface encloses.
+        for (l, want) in [(1, 36.0 - 2.0), (2, 1.0), (3, 1.0)] {
+            assert!((vol(l) - want).abs() < 1e-9 * 36.0, "{}: {regions:?}", l);
+        }
+        // Every interface triangle is a face between its two labels.
+        let c = json_of(&biotet(&["check", s(&out), "-s", s(input), "--json"]));
+        assert_eq!(c["valid"], true, "{c}");
+        let interfaces = c["surface"]["interfaces"].as_array().unwrap();
+        assert_eq!(interfaces.len(), 4, "{interfaces:?}"); // [0,1] [1,2] [1,3] [2,3]
+        for i in interfaces {
+            assert_eq!(i["found"], i["expected"], "{i}");
+        }
+        let i23 = interfaces
+            .iter()
+            .find(|i| i["labels"] == serde_json::json!([2, 3]));
+        assert_eq!(i23.unwrap()["expected"], 2);
+        for g in c["regions"].as_array().unwrap() {
+            let (v, e) = (
+                g["volume"].as_f64().unwrap(),
+                g["enclosed_volume"].as_f64().unwrap(),
+            );
+            assert!((v - e).abs() < 1e-9 * 36.0, "{g}");
+        }
+        // `quality` reports the faces between each pair of regions.
+        let q = json_of(&biotet(&["quality", s(&out), "--json"]));
+        let qi = q["interfaces"].as_array().unwrap();
+        let f23 = qi
+            .iter()
+            .find(|i| i["labels"] == serde_json::json!([2, 3]))
+            .unwrap();
+        assert!((f23["area"].as_f64().unwrap() - 1.0).abs() < 1e-12, "{f23}");
+        tet_counts.push(j["pipeline"]["n_tets"].clone());
+    }
+    // The three files hold the same model: the same mesh.
+    assert!(
+        tet_counts.windows(2).all(|w| w[0] == w[1]),
+        "{tet_counts:?}"
+    );
+}
+
+#[test]
+fn bad_side_labels_name_the_file_and_the_triangle() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = three_regions_ply();
+    let (head, body) = good.split_once("end_header\n").unwrap();
+    let lines: Vec<&str> = body.lines().collect();
+    let n_pts: usize = head
+        .lines()
+        .find_map(|l| l.strip_prefix("element vertex "))
+        .unwrap()
+        .parse()
+        .unwrap();
+    let write = |name: &str, faces: Vec<String>| {
+        let p = dir.path().join(name);
+        let text = format!(
+            "{}end_header\n{}\n{}\n",
+            head.replace(
+                &format!("element face {}", lines.len() - n_pts),
+                &format!("element face {}", faces.len())
+            ),
+            lines[..n_pts].join("\n"),
+            faces.join("\n")
+        );
+        std::fs::write(&p, text).unwrap();
+        p
+    };
+    let faces: Vec<String> = lines[n_pts..].iter().map(|l| l.to_string()).collect();
+    let refused = |p: &Path, what: &str| {
+        let out = biotet(&["mesh", s(p), "--size", "0.5"]);
+        assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+        let e = stderr(&out);
+        assert!(e.contains(s(p)) && e.contains(what), "{e}");
+        e
+    };
+    // Inconsistent labels: a Medit file with each triangle once, ref = the region behind it,
+    // where one triangle of cube 2 claims region 3.
+    let k = faces.iter().position(|f| f.ends_with(" 2 1")).unwrap();
+    let mut medit = format!("MeshVersionFormatted 2\nDimension 3\nVertices\n{n_pts}\n");
+    for l in &lines[..n_pts] {
+        medit += &format!("{l} 0\n");
+    }
+    medit += &format!("Triangles\n{}\n", faces.len());
+    for (i, f) in faces.iter().enumerate() {
+        let v: Vec<usize> = f.split(' ').map(|x| x.parse().unwrap()).collect();
+        let back = if i == k { 3 } else { v[4] };
+        medit += &format!("{} {} {} {back}\n", v[1] + 1, v[2] + 1, v[3] + 1);
+    }
+    medit += "End\n";
+    let p = dir.path().join("labels.mesh");
+    std::fs::write(&p, medit).unwrap();
+    let e = refused(&p, "disagree with the geometry");
+    assert!(
+        e.contains(&format!("triangle {k}: its back side is labelled 3")),
+        "{e}"
+    );
+    // An open region: a triangle of cube 3 removed.
+    let k = faces.iter().position(|f| f.ends_with(" 3 1")).unwrap();
+    let mut open = faces.clone();
+    open.remove(k);
+    refused(&write("open.ply", open), "not closed");
+    // A crossing pair of shells: cube 2 moved half a unit into the box's corner region is not
+    // possible without new points, so cross two boxes instead: the outer box and a box through
+    // its wall (both labelled against the outside).
+    let crossing = "ply\nformat ascii 1.0\nelement vertex 16\nproperty double x\n\
+        property double y\nproperty double z\nelement face 24\n\
+        property list uchar int vertex_indices\nproperty int label_back\n\
+        property int label_front\nend_header\n";
+    let mut text = crossing.to_string();
+    let cube = |o: [f64; 3], k: f64| -> Vec<[f64; 3]> {
+        (0..8)
+            .map(|i| {
+                [
+                    o[0] + k * (i & 1) as f64,
+                    o[1] + k * ((i >> 1) & 1) as f64,
+                    o[2] + k * ((i >> 2) & 1) as f64,
+                ]
+            })
+            .collect()
+    };
+    for p in cube([0.0; 3], 2.0).iter().chain(&cube([1.0; 3], 2.0)) {
+        text += &format!("{} {} {}\n", p[0], p[1], p[2]);
+    }
+    let quads = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    for (base, label) in [(0, 1), (8, 2)] {
+        for q in quads {
+            let q = q.map(|v| v + base);
+            text += &format!("3 {} {} {} {label} 0\n", q[0], q[1], q[2]);
+            text += &format!("3 {} {} {} {label} 0\n", q[0], q[2], q[3]);
+        }
+    }
+    let p = dir.path().join("crossing.ply");
+    std::fs::write(&p, text).unwrap();
+    refused(&p, "intersect");
 }

@@ -65,6 +65,15 @@ pub(crate) fn label_of(v: i64) -> std::result::Result<u32, String> {
     u32::try_from(v).map_err(|_| format!("region label {v} is not in 0..={}", u32::MAX))
 }
 
+/// A region label on one side of a surface triangle: [`label_of`], with
+/// [`FROM_GEOMETRY`](biotet::mesh::side_labels::FROM_GEOMETRY) reserved.
+pub(crate) fn side_label_of(v: i64) -> std::result::Result<u32, String> {
+    match label_of(v)? {
+        biotet::mesh::side_labels::FROM_GEOMETRY => Err(format!("region label {v} is reserved")),
+        l => Ok(l),
+    }
+}
+
 /// A label from a float attribute (TetGen writes attributes as reals).
 pub(crate) fn label_of_f64(v: f64) -> std::result::Result<u32, String> {
     if v.fract() == 0.0 && (0.0..=u32::MAX as f64).contains(&v) {

@@ -2,7 +2,7 @@
 //!
 //! | kind | formats (extension, case-insensitive) | read | write |
 //! |---|---|---|---|
-//! | surface ([`SurfaceMesh`]) | STL `.stl` (ASCII/binary), OBJ `.obj`, OFF `.off`, PLY `.ply` (ASCII/binary LE/BE), Medit `.mesh` | ✓ | ✓ |
+//! | surface ([`SurfaceMesh`]) | STL `.stl` (ASCII/binary), OBJ `.obj`, OFF `.off`, PLY `.ply` (ASCII/binary LE/BE), Medit `.mesh`, VTU `.vtu` (triangles with side labels) | ✓ | ✓ |
 //! | tet mesh ([`TetMesh`]) | VTU `.vtu`, Medit `.mesh`, Gmsh `.msh` (4.1 ASCII/binary, 2.2 ASCII), TetGen `.node`/`.ele`(/`.face`) | ✓ | ✓ |
 //! | 2D mesh ([`TriMesh`]) | Medit `.mesh` (`Dimension 2`), Triangle `.node`/`.ele` | ✓ | ✓ |
 //! | 2D mesh ([`TriMesh`]) | VTU `.vtu`, Gmsh `.msh` (2.2 ASCII) | | ✓ |
@@ -71,6 +71,12 @@ pub struct SurfaceRead {
     /// Per-triangle refs when the file has them (Medit triangle refs; a PLY face property named
     /// `ref`, `label`, `region` or `marker`).
     pub triangle_refs: Option<Vec<i32>>,
+    /// Region labels on both sides of each triangle, `[back, front]` as in
+    /// [`SurfaceMesh::sides`], when the file gives them (a PLY or VTU two-label attribute;
+    /// Medit refs naming the region behind each triangle, see [`medit`]), else `None`. A side
+    /// the file leaves to the geometry is [`biotet::mesh::side_labels::FROM_GEOMETRY`];
+    /// [`biotet::mesh::side_labels::resolve`] fills it and checks the rest.
+    pub side_labels: Option<Vec<[u32; 2]>>,
     /// Points removed by welding exact duplicates (STL only; 0 otherwise).
     pub welded: usize,
     /// Polygonal faces (more than three corners) split into fans of triangles (OBJ, OFF, PLY).
@@ -146,6 +152,8 @@ pub enum SurfaceFormat {
     PlyAscii,
     /// Medit `.mesh` (`Dimension 3`, `Triangles`).
     Medit,
+    /// VTK XML unstructured grid `.vtu` of triangles with side labels ([`vtu::parse_surface`]).
+    Vtu,
 }
 
 /// Tet mesh file formats.
@@ -177,7 +185,7 @@ pub enum TriFormat {
 }
 
 /// Supported surface extensions, for messages.
-pub const SURFACE_EXTENSIONS: &str = ".stl, .obj, .off, .ply, .mesh";
+pub const SURFACE_EXTENSIONS: &str = ".stl, .obj, .off, .ply, .mesh, .vtu";
 /// Supported tet mesh extensions, for messages.
 pub const TET_EXTENSIONS: &str = ".vtu, .mesh, .msh, .node/.ele (TetGen)";
 /// Supported 2D mesh extensions, for messages.
@@ -205,6 +213,7 @@ impl SurfaceFormat {
             "off" => SurfaceFormat::Off,
             "ply" => SurfaceFormat::Ply,
             "mesh" => SurfaceFormat::Medit,
+            "vtu" => SurfaceFormat::Vtu,
             _ => {
                 return Err(Error::UnknownExtension {
                     path: name(path),
@@ -255,12 +264,18 @@ impl TriFormat {
 }
 
 /// Which kind of mesh `path` holds: by extension, looking inside `.mesh` files (their
-/// `Dimension` and whether they have tetrahedra, see [`medit::peek_kind`]) and TetGen/Triangle
+/// `Dimension` and whether they have tetrahedra, see [`medit::peek_kind`]), `.vtu` files (volume
+/// or surface cells, [`vtu::peek_kind`]) and TetGen/Triangle
 /// `.node`/`.ele` files (the dimension in the `.node` header).
 pub fn mesh_kind(path: &Path) -> Result<MeshKind> {
     match ext(path).as_str() {
         "stl" | "obj" | "off" | "ply" => Ok(MeshKind::Surface),
-        "vtu" | "msh" => Ok(MeshKind::Tetrahedra),
+        "msh" => Ok(MeshKind::Tetrahedra),
+        // Unreadable: by extension; reading it will say why.
+        "vtu" => match atomic::read_file(path) {
+            Ok(data) => vtu::peek_kind(&data, &name(path)),
+            Err(_) => Ok(MeshKind::Tetrahedra),
+        },
         "mesh" => medit::peek_kind(atomic::open(path)?, &name(path)),
         "node" | "ele" => {
             let node = tetgen::files(path).node;
@@ -292,6 +307,7 @@ pub fn read_surface_as(path: &Path, format: SurfaceFormat) -> Result<SurfaceRead
         SurfaceFormat::Off => off::parse(&data, &n),
         SurfaceFormat::Ply | SurfaceFormat::PlyAscii => ply::parse(&data, &n),
         SurfaceFormat::Medit => medit::parse_surface(&data, &n),
+        SurfaceFormat::Vtu => vtu::parse_surface(&data, &n),
     }
 }
 
@@ -311,6 +327,7 @@ pub fn write_surface_as(path: &Path, mesh: &SurfaceMesh, format: SurfaceFormat) 
         SurfaceFormat::Ply => ply::write_binary(w, mesh, &n),
         SurfaceFormat::PlyAscii => ply::write_ascii(w, mesh, &n),
         SurfaceFormat::Medit => medit::write_surface(w, mesh, &n),
+        SurfaceFormat::Vtu => vtu::write_surface(w, mesh, &n),
     })
 }
 

@@ -10,6 +10,22 @@
 //! as a tet mesh, tet refs are the region labels (negative refs are errors) and triangles are
 //! ignored; as a 2D mesh (`Dimension 2`), triangle refs are the labels.
 //!
+//! A surface (a file without tetrahedra) whose triangle refs are not all equal is a labelled
+//! multi-material surface, [`SurfaceRead::side_labels`]: each ref is the region *behind* its
+//! triangle (the normal points out of it; 0 = the outside), which is what the surface writer
+//! below writes. A triangle between two regions is given either once (its front region is then
+//! taken from the geometry: the region that the other triangles of that cell name) or twice with
+//! opposite orientations, once in the closed boundary of each region, as a file concatenating
+//! every region's outward surface has it; the second copy is merged into the first. A negative
+//! ref, a copy with the same orientation or the same ref, or a third copy is an error naming
+//! the line and the triangle. Refs that are all equal (say all 0 or all 1), or that include a
+//! negative one, carry no regions: the surface is read as closed shells, as from any other
+//! format, its refs kept in [`SurfaceRead::triangle_refs`].
+//!
+//! The surface writer writes every triangle with ref = the region behind it, and a triangle
+//! with a region in front (an interface) a second time, reversed, with ref = that region: every
+//! region's boundary is then complete in the file and reads back without the geometry.
+//!
 //! Writing (`MeshVersionFormatted 2`, shortest round-trip coordinates, vertex refs 0):
 //! - a surface: `Triangles` with ref = the region behind each triangle (`sides[t][0]`), or
 //!   given refs ([`write_surface_with_refs`]);
@@ -23,10 +39,12 @@
 
 use std::io::{BufRead, Write};
 
+use biotet::mesh::side_labels::FROM_GEOMETRY;
 use biotet::{SurfaceMesh, TetMesh, TriMesh};
 
 use crate::common::{
     check_surface, check_tet, check_tri, face_groups, label_of, orient_tets, orient_tris, read_all,
+    side_label_of,
 };
 use crate::error::{Error, Result};
 use crate::text::{Lexer, Out, show};
@@ -214,17 +232,85 @@ pub fn parse_surface(data: &[u8], file: &str) -> Result<SurfaceRead> {
             "a 2D mesh (Dimension 2), expected a 3D surface",
         ));
     }
-    let refs = m
-        .tri_refs
+    let labelled = m.tets.is_empty()
+        && m.tri_refs.windows(2).any(|w| w[0] != w[1])
+        && m.tri_refs.iter().all(|&r| side_label_of(r).is_ok());
+    let (tris, tri_refs, side_labels) = if labelled {
+        let (t, r, sides) = sides_from_refs(&m.tris, &m.tri_refs, &m.tri_lines, file)?;
+        (t, r, Some(sides))
+    } else {
+        (m.tris, m.tri_refs, None)
+    };
+    let refs = tri_refs
         .iter()
         .map(|&r| r.clamp(i32::MIN as i64, i32::MAX as i64) as i32)
         .collect();
     Ok(SurfaceRead {
-        mesh: SurfaceMesh::closed(m.verts, m.tris, 1),
+        mesh: SurfaceMesh::closed(m.verts, tris, 1),
         triangle_refs: Some(refs),
+        side_labels,
         welded: 0,
         polygons_split: 0,
     })
+}
+
+/// Triangle refs as region labels (see the module documentation): each ref names the region
+/// behind its triangle; a triangle given twice, with opposite orientations, names both sides and
+/// is kept once (the first copy); a triangle given once leaves its front to the geometry
+/// ([`FROM_GEOMETRY`]). Returns the kept triangles, their refs and their side labels.
+#[allow(clippy::type_complexity)]
+fn sides_from_refs(
+    tris: &[[u32; 3]],
+    refs: &[i64],
+    lines: &[usize],
+    file: &str,
+) -> Result<(Vec<[u32; 3]>, Vec<i64>, Vec<[u32; 2]>)> {
+    let mut first: std::collections::HashMap<[u32; 3], usize> = Default::default();
+    let mut kept = Vec::with_capacity(tris.len());
+    let mut kept_refs = Vec::with_capacity(tris.len());
+    let mut sides: Vec<[u32; 2]> = Vec::with_capacity(tris.len());
+    // Index of each kept triangle in the file, for messages.
+    let mut origin: Vec<usize> = Vec::with_capacity(tris.len());
+    for (j, (t, &r)) in tris.iter().zip(refs).enumerate() {
+        let err = |msg: String| Error::line(file, lines[j], format!("triangle {j}: {msg}"));
+        let label = side_label_of(r).map_err(&err)?;
+        let mut key = *t;
+        key.sort_unstable();
+        match first.get(&key) {
+            None => {
+                first.insert(key, kept.len());
+                kept.push(*t);
+                kept_refs.push(r);
+                sides.push([label, FROM_GEOMETRY]);
+                origin.push(j);
+            }
+            Some(&k) => {
+                let i = origin[k];
+                let a = kept[k];
+                let same = (0..3).any(|s| [a[s], a[(s + 1) % 3], a[(s + 2) % 3]] == *t);
+                if same {
+                    return Err(err(format!(
+                        "repeats triangle {i} with the same orientation; a triangle between two \
+                         regions is given once, or twice with opposite orientations (once in \
+                         the boundary of each region)"
+                    )));
+                }
+                if sides[k][1] != FROM_GEOMETRY {
+                    return Err(err(format!(
+                        "the third copy of triangle {i}; a triangle has two sides"
+                    )));
+                }
+                if sides[k][0] == label {
+                    return Err(err(format!(
+                        "repeats triangle {i} with the same ref {label}: the same region on \
+                         both sides"
+                    )));
+                }
+                sides[k][1] = label;
+            }
+        }
+    }
+    Ok((kept, kept_refs, sides))
 }
 
 /// Read a Medit tet mesh (`Dimension 3`, `Vertices`, `Tetrahedra`) from a stream.
@@ -405,9 +491,21 @@ fn cells_out<W: Write, const K: usize>(
     Ok(())
 }
 
-/// Write a surface with ref = the region behind each triangle (`sides[t][0]`).
+/// Write a surface with ref = the region behind each triangle (`sides[t][0]`), and each
+/// triangle with a region in front of it (`sides[t][1] != 0`) once more, reversed, with that
+/// region as ref (see the module documentation).
 pub fn write_surface<W: Write>(w: W, mesh: &SurfaceMesh, file: &str) -> Result<()> {
-    write_surface_with_refs(w, mesh, None, file)
+    if mesh.sides.len() != mesh.triangles.len() || mesh.sides.iter().all(|s| s[1] == 0) {
+        return write_surface_with_refs(w, mesh, None, file);
+    }
+    let mut both = mesh.clone();
+    for (t, s) in mesh.triangles.iter().zip(&mesh.sides) {
+        if s[1] != 0 {
+            both.triangles.push([t[0], t[2], t[1]]);
+            both.sides.push([s[1], s[0]]);
+        }
+    }
+    write_surface_with_refs(w, &both, None, file)
 }
 
 /// Write a surface with the given triangle refs (or the back regions when `None`).

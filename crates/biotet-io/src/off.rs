@@ -125,6 +125,7 @@ pub fn parse(data: &[u8], file: &str) -> Result<SurfaceRead> {
     Ok(SurfaceRead {
         mesh: SurfaceMesh::closed(points, triangles, 1),
         triangle_refs: None,
+        side_labels: None,
         welded: 0,
         polygons_split: split,
     })

@@ -7,8 +7,15 @@
 //! [`SurfaceRead::polygons_split`]. An integer scalar face property named `ref`, `label`,
 //! `region` or `marker` becomes [`SurfaceRead::triangle_refs`]. Other elements are skipped.
 //!
+//! Two region labels per face, `[back, front]` as in [`SurfaceMesh::sides`] (the front is where
+//! the right-hand normal of the corner order points; 0 = the outside), become
+//! [`SurfaceRead::side_labels`]: integer scalar properties `label_back` and `label_front` (or
+//! `region_back` and `region_front`), or a two-item integer list property `sides`,
+//! `boundary_labels` or `BoundaryLabels` (back first). A polygon's fan triangles share its labels.
+//!
 //! Writing: [`write_binary`] (little endian, `double` coordinates, `uchar`/`int` face lists)
-//! and [`write_ascii`] (shortest round-trip coordinates).
+//! and [`write_ascii`] (shortest round-trip coordinates); a surface with some side other than
+//! `[1, 0]` also gets `uint label_back` and `uint label_front` face properties.
 
 use std::io::Write;
 
@@ -247,6 +254,9 @@ pub fn parse(data: &[u8], file: &str) -> Result<SurfaceRead> {
     let mut triangles: Vec<[u32; 3]> = Vec::new();
     let mut refs: Vec<i32> = Vec::new();
     let mut has_refs = false;
+    // The face properties holding the two side labels, and the labels of each triangle.
+    let mut side_props: Option<SideProps> = None;
+    let mut sides: Vec<[u32; 2]> = Vec::new();
     let mut have_vertices = false;
     let mut split = 0;
     let mut corners: Vec<u32> = Vec::new();
@@ -291,6 +301,7 @@ pub fn parse(data: &[u8], file: &str) -> Result<SurfaceRead> {
                     && matches!(&p.name[..], b"ref" | b"label" | b"region" | b"marker")
             });
             has_refs = ri.is_some();
+            side_props = side_label_props(&el.props, li);
             triangles.reserve(reserve_cap(el.count, left, 4));
             ([usize::MAX; 3], Some(li), ri)
         } else {
@@ -309,6 +320,7 @@ pub fn parse(data: &[u8], file: &str) -> Result<SurfaceRead> {
         for r in 0..el.count {
             let mut p = [0.0; 3];
             let mut refv = 0i32;
+            let mut side = [0u32; 2];
             for (pi, prop) in el.props.iter().enumerate() {
                 if let Some(ct) = prop.list {
                     let n = src.value(ct, "list length", what, r)?;
@@ -345,6 +357,21 @@ pub fn parse(data: &[u8], file: &str) -> Result<SurfaceRead> {
                             }
                             corners.push(v as u32);
                         }
+                    } else if is_face && side_props == Some(SideProps::List(pi)) {
+                        if n != 2 {
+                            return Err(src.err(
+                                what,
+                                r,
+                                format!(
+                                    "list '{}' has {n} items, expected 2 (back and front labels)",
+                                    show(&prop.name)
+                                ),
+                            ));
+                        }
+                        for x in &mut side {
+                            let v = src.value(prop.ty, "side label", what, r)?;
+                            *x = ply_side_label(v, prop, &src, what, r)?;
+                        }
                     } else {
                         if fmt != Fmt::Ascii
                             && n.saturating_mul(prop.ty.size()) > data.len() - src.lx.pos
@@ -369,6 +396,11 @@ pub fn parse(data: &[u8], file: &str) -> Result<SurfaceRead> {
                         refv = i32::try_from(v as i64).map_err(|_| {
                             src.err(what, r, format!("ref {v} does not fit a 32-bit integer"))
                         })?;
+                    } else if let Some(SideProps::Pair(b, f)) = side_props
+                        && is_face
+                        && (pi == b || pi == f)
+                    {
+                        side[usize::from(pi == f)] = ply_side_label(v, prop, &src, what, r)?;
                     }
                 }
             }
@@ -386,6 +418,9 @@ pub fn parse(data: &[u8], file: &str) -> Result<SurfaceRead> {
                     if has_refs {
                         refs.push(refv);
                     }
+                    if side_props.is_some() {
+                        sides.push(side);
+                    }
                 }
             }
         }
@@ -393,9 +428,59 @@ pub fn parse(data: &[u8], file: &str) -> Result<SurfaceRead> {
     Ok(SurfaceRead {
         mesh: SurfaceMesh::closed(points, triangles, 1),
         triangle_refs: has_refs.then_some(refs),
+        side_labels: side_props.is_some().then_some(sides),
         welded: 0,
         polygons_split: split,
     })
+}
+
+/// Where a face element keeps its two side labels.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum SideProps {
+    /// Two integer scalar properties: back, front.
+    Pair(usize, usize),
+    /// An integer list property of two items: back, front.
+    List(usize),
+}
+
+/// Names of the scalar property pairs holding the side labels, `(back, front)`.
+const SIDE_PAIRS: [(&[u8], &[u8]); 2] = [
+    (b"label_back", b"label_front"),
+    (b"region_back", b"region_front"),
+];
+/// Names of the two-item list properties holding the side labels (back first).
+const SIDE_LISTS: [&[u8]; 3] = [b"sides", b"boundary_labels", b"BoundaryLabels"];
+
+/// The side-label properties of a face element whose corner list is property `corners`.
+fn side_label_props(props: &[Prop], corners: usize) -> Option<SideProps> {
+    let scalar = |n: &[u8]| {
+        props
+            .iter()
+            .position(|p| p.list.is_none() && p.ty.is_int() && p.name == n)
+    };
+    for (b, f) in SIDE_PAIRS {
+        if let (Some(b), Some(f)) = (scalar(b), scalar(f)) {
+            return Some(SideProps::Pair(b, f));
+        }
+    }
+    SIDE_LISTS.iter().find_map(|n| {
+        props
+            .iter()
+            .enumerate()
+            .position(|(i, p)| i != corners && p.list.is_some() && p.ty.is_int() && p.name == *n)
+            .map(SideProps::List)
+    })
+}
+
+/// A side label read as `v` from `prop`.
+fn ply_side_label(v: f64, prop: &Prop, src: &Src, what: &'static str, r: usize) -> Result<u32> {
+    crate::common::side_label_of(v as i64)
+        .map_err(|e| src.err(what, r, format!("property '{}': {e}", show(&prop.name))))
+}
+
+/// Whether a surface carries labels worth writing (any side other than `[1, 0]`).
+fn labelled(mesh: &SurfaceMesh) -> bool {
+    mesh.sides.len() == mesh.triangles.len() && mesh.sides.iter().any(|s| *s != [1, 0])
 }
 
 fn header<W: Write>(out: &mut Out<W>, fmt: &str, mesh: &SurfaceMesh) {
@@ -411,12 +496,18 @@ fn header<W: Write>(out: &mut Out<W>, fmt: &str, mesh: &SurfaceMesh) {
     } else {
         "uint"
     });
-    out.s(" vertex_indices\nend_header\n");
+    out.s(" vertex_indices\n");
+    if labelled(mesh) {
+        out.s("property uint label_back\nproperty uint label_front\n");
+    }
+    out.s("end_header\n");
 }
 
-/// Write a binary little-endian PLY surface.
+/// Write a binary little-endian PLY surface (with `label_back`, `label_front` face properties
+/// when some side is not `[1, 0]`).
 pub fn write_binary<W: Write>(w: W, mesh: &SurfaceMesh, file: &str) -> Result<()> {
     check_surface(mesh, file)?;
+    let labels = labelled(mesh);
     let mut out = Out::new(w);
     header(&mut out, "binary_little_endian", mesh);
     for p in &mesh.points {
@@ -425,10 +516,15 @@ pub fn write_binary<W: Write>(w: W, mesh: &SurfaceMesh, file: &str) -> Result<()
         }
         out.check().map_err(|e| Error::io(file, e))?;
     }
-    for t in &mesh.triangles {
+    for (i, t) in mesh.triangles.iter().enumerate() {
         out.c(3);
         for &v in t {
             out.bytes(&v.to_le_bytes());
+        }
+        if labels {
+            for l in mesh.sides[i] {
+                out.bytes(&l.to_le_bytes());
+            }
         }
         out.check().map_err(|e| Error::io(file, e))?;
     }
@@ -436,10 +532,32 @@ pub fn write_binary<W: Write>(w: W, mesh: &SurfaceMesh, file: &str) -> Result<()
     Ok(())
 }
 
-/// Write an ASCII PLY surface.
+/// Write an ASCII PLY surface (labels as in [`write_binary`]).
 pub fn write_ascii<W: Write>(w: W, mesh: &SurfaceMesh, file: &str) -> Result<()> {
     check_surface(mesh, file)?;
     let mut out = Out::new(w);
     header(&mut out, "ascii", mesh);
-    write_points_and_counted_triangles(out, mesh, file)
+    if !labelled(mesh) {
+        return write_points_and_counted_triangles(out, mesh, file);
+    }
+    for p in &mesh.points {
+        out.f64(p[0]);
+        out.c(b' ');
+        out.f64(p[1]);
+        out.c(b' ');
+        out.f64(p[2]);
+        out.c(b'\n');
+        out.check().map_err(|e| Error::io(file, e))?;
+    }
+    for (t, s) in mesh.triangles.iter().zip(&mesh.sides) {
+        out.c(b'3');
+        for v in t.iter().chain(s) {
+            out.c(b' ');
+            out.int(*v);
+        }
+        out.c(b'\n');
+        out.check().map_err(|e| Error::io(file, e))?;
+    }
+    out.finish().map_err(|e| Error::io(file, e))?;
+    Ok(())
 }

@@ -38,6 +38,7 @@ pub fn parse(data: &[u8], file: &str) -> Result<SurfaceRead> {
     Ok(SurfaceRead {
         mesh,
         triangle_refs: None,
+        side_labels: None,
         welded,
         polygons_split: 0,
     })

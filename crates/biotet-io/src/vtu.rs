@@ -1,4 +1,11 @@
-//! VTK XML unstructured grid (`.vtu`): tet meshes.
+//! VTK XML unstructured grid (`.vtu`): tet meshes, and surfaces with side labels.
+//!
+//! Surfaces ([`parse_surface`], [`write_surface`]): triangle, quad and polygon cells (quads and
+//! polygons fan-split), with the region labels on both sides of each as the two-component
+//! cell-data array `sides` (`[back, front]`: behind and in front of the right-hand normal of the
+//! corner order, 0 = the outside; `BoundaryLabels`, as VTK's SurfaceNets filters write, and
+//! `boundary_labels`, as PyVista writes, are read the same way) or two scalar arrays
+//! `label_back` and `label_front`. [`peek_kind`] tells the two kinds apart.
 //!
 //! Writing: by default ([`VtuEncoding::Raw`]) all arrays go, uncompressed, into one
 //! `<AppendedData encoding="raw">` block with `UInt64` byte-count headers — the fastest to write
@@ -21,15 +28,15 @@
 
 use std::io::{Read, Write};
 
-use biotet::TetMesh;
 use biotet::quality::tet::TetMeasures;
+use biotet::{SurfaceMesh, TetMesh};
 
-use crate::TetRead;
 use crate::b64;
-use crate::common::{check_tet, orient_tets, read_all};
+use crate::common::{check_surface, check_tet, orient_tets, read_all};
 use crate::error::{Error, Result};
 use crate::text::{Out, show};
 use crate::vtkxml::{ArrayRef, Ctx, Values};
+use crate::{MeshKind, SurfaceRead, TetRead};
 
 /// How [`write_tet_with`] encodes the data arrays.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -184,6 +191,28 @@ pub fn write_tet<W: Write>(w: W, mesh: &TetMesh, file: &str) -> Result<()> {
 pub fn write_tet_with<W: Write>(w: W, mesh: &TetMesh, file: &str, enc: VtuEncoding) -> Result<()> {
     check_tet(mesh, file)?;
     let (arrays, first_cell_array) = arrays(mesh, file)?;
+    write_grid(
+        w,
+        (mesh.points.len(), mesh.tets.len()),
+        &arrays,
+        first_cell_array,
+        "region",
+        file,
+        enc,
+    )
+}
+
+/// Write an unstructured grid of `sizes = (points, cells)` from its arrays: `Points`, the three
+/// cell arrays, then cell data from index `first_cell_array` on, `scalars` the active one.
+fn write_grid<W: Write>(
+    w: W,
+    sizes: (usize, usize),
+    arrays: &[Array],
+    first_cell_array: usize,
+    scalars: &str,
+    file: &str,
+    enc: VtuEncoding,
+) -> Result<()> {
     let zlib = matches!(enc, VtuEncoding::RawZlib | VtuEncoding::Base64Zlib);
     let io = |e| Error::io(file, e);
     let mut out = Out::new(w);
@@ -192,9 +221,9 @@ pub fn write_tet_with<W: Write>(w: W, mesh: &TetMesh, file: &str, enc: VtuEncodi
         out.s(" compressor=\"vtkZLibDataCompressor\"");
     }
     out.s(">\n  <UnstructuredGrid>\n    <Piece NumberOfPoints=\"");
-    out.int(mesh.points.len());
+    out.int(sizes.0);
     out.s("\" NumberOfCells=\"");
-    out.int(mesh.tets.len());
+    out.int(sizes.1);
     out.s("\">\n");
     // Appended blocks, computed up front for their offsets.
     let appended = matches!(enc, VtuEncoding::Raw | VtuEncoding::RawZlib);
@@ -204,7 +233,11 @@ pub fn write_tet_with<W: Write>(w: W, mesh: &TetMesh, file: &str, enc: VtuEncodi
         match k {
             0 => out.s("      <Points>\n"),
             1 => out.s("      <Cells>\n"),
-            _ if k == first_cell_array => out.s("      <CellData Scalars=\"region\">\n"),
+            _ if k == first_cell_array => {
+                out.s("      <CellData Scalars=\"");
+                out.s(scalars);
+                out.s("\">\n");
+            }
             _ => {}
         }
         out.s("        <DataArray type=\"");
@@ -320,8 +353,8 @@ const LABEL_NAMES: [&str; 9] = [
     "MaterialIds",
 ];
 
-/// Parse a VTU tet mesh held in memory.
-pub fn parse_tet(data: &[u8], file: &str) -> Result<TetRead> {
+/// The pieces of a VTU file, with the context to decode their arrays.
+fn read_pieces<'a>(data: &'a [u8], file: &'a str) -> Result<(Ctx<'a>, Vec<Piece<'a>>)> {
     let (mut ctx, xml_end) = Ctx::new(data, file)?;
     let xml = &data[..xml_end];
     let mut pos = 0;
@@ -399,66 +432,127 @@ pub fn parse_tet(data: &[u8], file: &str) -> Result<TetRead> {
         pieces.push(p);
     }
     ctx.end_of_xml();
+    Ok((ctx, pieces))
+}
 
+/// Append the points of piece `pi` to `points`.
+fn read_points(ctx: &Ctx, p: &Piece, pi: usize, points: &mut Vec<[f64; 3]>) -> Result<()> {
+    let file = ctx.file;
+    let base = points.len();
+    if p.npts == 0 {
+        return Ok(());
+    }
+    let a = p
+        .points
+        .as_ref()
+        .ok_or_else(|| Error::format(file, format!("piece {pi} has no Points array")))?;
+    if a.ncomp != 3 {
+        return Err(ctx.err_at(
+            a.at,
+            format!("Points with {} components, expected 3", a.ncomp),
+        ));
+    }
+    let cap = p
+        .npts
+        .checked_mul(3)
+        .ok_or_else(|| Error::format(file, "too many points"))?;
+    let v = match ctx.values(a, Some(cap))? {
+        Values::F(v) => v,
+        Values::I(v) => v.into_iter().map(|x| x as f64).collect(),
+    };
+    for (i, c) in v.chunks_exact(3).enumerate() {
+        if c.iter().any(|x| !x.is_finite()) {
+            return Err(Error::element(
+                file,
+                "point",
+                base + i,
+                format!("non-finite coordinate {c:?}"),
+            ));
+        }
+        points.push([c[0], c[1], c[2]]);
+    }
+    if points.len() > u32::MAX as usize {
+        return Err(Error::format(file, "too many points for 32-bit indices"));
+    }
+    Ok(())
+}
+
+/// The cells of piece `pi`: offsets, types and connectivity, decoded.
+fn read_cells(ctx: &Ctx, p: &Piece, pi: usize) -> Result<(Vec<i64>, Vec<i64>, Vec<i64>)> {
+    let file = ctx.file;
+    fn need<'b, 'c>(
+        a: &'b Option<ArrayRef<'c>>,
+        n: &str,
+        pi: usize,
+        file: &str,
+    ) -> Result<&'b ArrayRef<'c>> {
+        a.as_ref()
+            .ok_or_else(|| Error::format(file, format!("piece {pi} has no '{n}' cell array")))
+    }
+    let offsets = ctx.ints(need(&p.offsets, "offsets", pi, file)?, Some(p.ncells))?;
+    let types = ctx.ints(need(&p.types, "types", pi, file)?, Some(p.ncells))?;
+    let nconn = offsets.last().copied().unwrap_or(0);
+    let nconn = usize::try_from(nconn)
+        .map_err(|_| Error::element(file, "cell", p.ncells - 1, format!("bad offset {nconn}")))?;
+    let conn = ctx.ints(need(&p.conn, "connectivity", pi, file)?, Some(nconn))?;
+    Ok((offsets, types, conn))
+}
+
+/// The point indices of cell `i`, checked against the connectivity and the piece's points and
+/// shifted by `base`; `prev` is the end of the previous cell in the connectivity.
+fn cell_points(
+    file: &str,
+    i: usize,
+    (offsets, conn): (&[i64], &[i64]),
+    prev: &mut usize,
+    npts: usize,
+    base: usize,
+    out: &mut Vec<u32>,
+) -> Result<()> {
+    let end = offsets[i];
+    if end < *prev as i64 || end > conn.len() as i64 {
+        return Err(Error::element(
+            file,
+            "cell",
+            i,
+            format!(
+                "offset {end} out of order or past the connectivity ({} entries)",
+                conn.len()
+            ),
+        ));
+    }
+    let end = end as usize;
+    out.clear();
+    for &v in &conn[*prev..end] {
+        if v < 0 || v as u64 >= npts as u64 {
+            return Err(Error::element(
+                file,
+                "cell",
+                i,
+                format!("point index {v} out of range ({npts} points)"),
+            ));
+        }
+        out.push((base + v as usize) as u32);
+    }
+    *prev = end;
+    Ok(())
+}
+
+/// Parse a VTU tet mesh held in memory.
+pub fn parse_tet(data: &[u8], file: &str) -> Result<TetRead> {
+    let (ctx, pieces) = read_pieces(data, file)?;
     let mut points: Vec<[f64; 3]> = Vec::new();
     let mut tets: Vec<[u32; 4]> = Vec::new();
     let mut labels: Vec<u32> = Vec::new();
     let mut skipped = 0;
+    let mut c: Vec<u32> = Vec::new();
     for (pi, p) in pieces.iter().enumerate() {
         let base = points.len();
-        if p.npts > 0 {
-            let a = p
-                .points
-                .as_ref()
-                .ok_or_else(|| Error::format(file, format!("piece {pi} has no Points array")))?;
-            if a.ncomp != 3 {
-                return Err(ctx.err_at(
-                    a.at,
-                    format!("Points with {} components, expected 3", a.ncomp),
-                ));
-            }
-            let cap = p
-                .npts
-                .checked_mul(3)
-                .ok_or_else(|| Error::format(file, "too many points"))?;
-            let v = match ctx.values(a, Some(cap))? {
-                Values::F(v) => v,
-                Values::I(v) => v.into_iter().map(|x| x as f64).collect(),
-            };
-            for (i, c) in v.chunks_exact(3).enumerate() {
-                if c.iter().any(|x| !x.is_finite()) {
-                    return Err(Error::element(
-                        file,
-                        "point",
-                        base + i,
-                        format!("non-finite coordinate {c:?}"),
-                    ));
-                }
-                points.push([c[0], c[1], c[2]]);
-            }
-            if points.len() > u32::MAX as usize {
-                return Err(Error::format(file, "too many points for 32-bit indices"));
-            }
-        }
+        read_points(&ctx, p, pi, &mut points)?;
         if p.ncells == 0 {
             continue;
         }
-        fn need<'b, 'c>(
-            a: &'b Option<ArrayRef<'c>>,
-            n: &str,
-            pi: usize,
-            file: &str,
-        ) -> Result<&'b ArrayRef<'c>> {
-            a.as_ref()
-                .ok_or_else(|| Error::format(file, format!("piece {pi} has no '{n}' cell array")))
-        }
-        let offsets = ctx.ints(need(&p.offsets, "offsets", pi, file)?, Some(p.ncells))?;
-        let types = ctx.ints(need(&p.types, "types", pi, file)?, Some(p.ncells))?;
-        let nconn = offsets.last().copied().unwrap_or(0);
-        let nconn = usize::try_from(nconn).map_err(|_| {
-            Error::element(file, "cell", p.ncells - 1, format!("bad offset {nconn}"))
-        })?;
-        let conn = ctx.ints(need(&p.conn, "connectivity", pi, file)?, Some(nconn))?;
+        let (offsets, types, conn) = read_cells(&ctx, p, pi)?;
         let label_arr = LABEL_NAMES
             .iter()
             .find_map(|n| {
@@ -477,39 +571,14 @@ pub fn parse_tet(data: &[u8], file: &str) -> Result<TetRead> {
         };
         let mut prev = 0usize;
         for i in 0..p.ncells {
-            let end = offsets[i];
-            if end < prev as i64 || end > conn.len() as i64 {
-                return Err(Error::element(
-                    file,
-                    "cell",
-                    i,
-                    format!(
-                        "offset {end} out of order or past the connectivity ({} entries)",
-                        conn.len()
-                    ),
-                ));
-            }
-            let end = end as usize;
-            let c = &conn[prev..end];
-            prev = end;
+            cell_points(file, i, (&offsets, &conn), &mut prev, p.npts, base, &mut c)?;
             if types[i] != 10 || c.len() != 4 {
                 if is_volume_cell(types[i]) {
                     skipped += 1;
                 }
                 continue;
             }
-            let mut t = [0u32; 4];
-            for (x, &v) in t.iter_mut().zip(c) {
-                if v < 0 || v as u64 >= p.npts as u64 {
-                    return Err(Error::element(
-                        file,
-                        "cell",
-                        i,
-                        format!("point index {v} out of range ({} points)", p.npts),
-                    ));
-                }
-                *x = (base + v as usize) as u32;
-            }
+            let t = [c[0], c[1], c[2], c[3]];
             let l = match &lab {
                 Some((a, v)) => crate::common::label_of(v[i]).map_err(|e| {
                     Error::element(file, "cell", i, format!("array '{}': {e}", show(a.name)))
@@ -527,4 +596,207 @@ pub fn parse_tet(data: &[u8], file: &str) -> Result<TetRead> {
         degenerate,
         skipped_elements: skipped,
     })
+}
+
+// ---------------------------------------------------------------------------------------------
+// Surfaces.
+
+/// VTK cell types read as surface polygons: triangle, polygon, quad.
+fn is_surface_cell(t: i64) -> bool {
+    matches!(t, 5 | 7 | 9)
+}
+
+/// Two-component cell-data arrays holding the side labels `[back, front]`, in order of
+/// preference (`sides`: biotet; `BoundaryLabels`: VTK's SurfaceNets; `boundary_labels`: PyVista).
+const SIDE_ARRAYS: [&str; 3] = ["sides", "BoundaryLabels", "boundary_labels"];
+/// Scalar cell-data array pairs holding the side labels, `(back, front)`.
+const SIDE_PAIRS: [(&str, &str); 2] = [
+    ("label_back", "label_front"),
+    ("region_back", "region_front"),
+];
+
+/// Side labels of a piece's cells: the array name(s), then back and front values per cell.
+type SideArrays<'a> = (Vec<&'a [u8]>, Vec<i64>, Vec<i64>);
+
+/// What a VTU file holds: [`MeshKind::Tetrahedra`] when it has a volume cell (or no surface
+/// cell), else [`MeshKind::Surface`]. Decodes only the cell types.
+pub fn peek_kind(data: &[u8], file: &str) -> Result<MeshKind> {
+    let (ctx, pieces) = read_pieces(data, file)?;
+    let mut surface = false;
+    for p in &pieces {
+        let Some(t) = p.types.as_ref().filter(|_| p.ncells > 0) else {
+            continue;
+        };
+        for ty in ctx.ints(t, Some(p.ncells))? {
+            if is_volume_cell(ty) {
+                return Ok(MeshKind::Tetrahedra);
+            }
+            surface |= is_surface_cell(ty);
+        }
+    }
+    Ok(if surface {
+        MeshKind::Surface
+    } else {
+        MeshKind::Tetrahedra
+    })
+}
+
+/// Read a VTU surface from a stream.
+pub fn read_surface<R: Read>(r: R, file: &str) -> Result<SurfaceRead> {
+    parse_surface(&read_all(r, file)?, file)
+}
+
+/// Parse a VTU surface held in memory: triangles, quads and polygons (fan-split), the side
+/// labels from a two-component cell-data array `sides`, `BoundaryLabels` or `boundary_labels`,
+/// or from two scalar arrays `label_back` and `label_front` (or `region_back`, `region_front`).
+/// Volume cells are an error (a tet mesh); vertices and lines are ignored.
+pub fn parse_surface(data: &[u8], file: &str) -> Result<SurfaceRead> {
+    let (ctx, pieces) = read_pieces(data, file)?;
+    let mut points: Vec<[f64; 3]> = Vec::new();
+    let mut triangles: Vec<[u32; 3]> = Vec::new();
+    let mut sides: Vec<[u32; 2]> = Vec::new();
+    let mut labelled = None;
+    let mut split = 0;
+    let mut c: Vec<u32> = Vec::new();
+    for (pi, p) in pieces.iter().enumerate() {
+        let base = points.len();
+        read_points(&ctx, p, pi, &mut points)?;
+        if p.ncells == 0 {
+            continue;
+        }
+        let (offsets, types, conn) = read_cells(&ctx, p, pi)?;
+        let find = |n: &str, ncomp: usize| {
+            p.cell_data
+                .iter()
+                .find(|a| a.name == n.as_bytes() && a.ncomp == ncomp && !a.ty.is_float())
+        };
+        let mut lab: Option<SideArrays> = None;
+        if let Some(a) = SIDE_ARRAYS.iter().find_map(|n| find(n, 2)) {
+            let v = ctx.ints(a, Some(2 * p.ncells))?;
+            let (b, f) = v.chunks_exact(2).map(|x| (x[0], x[1])).unzip();
+            lab = Some((vec![a.name], b, f));
+        } else if let Some((b, f)) = SIDE_PAIRS
+            .iter()
+            .find_map(|(b, f)| Some((find(b, 1)?, find(f, 1)?)))
+        {
+            lab = Some((
+                vec![b.name, f.name],
+                ctx.ints(b, Some(p.ncells))?,
+                ctx.ints(f, Some(p.ncells))?,
+            ));
+        }
+        if let Some(prev) = labelled
+            && prev != lab.is_some()
+        {
+            return Err(Error::format(
+                file,
+                format!("piece {pi}: side labels in some pieces but not in others"),
+            ));
+        }
+        labelled = Some(lab.is_some());
+        let mut prev = 0usize;
+        for i in 0..p.ncells {
+            cell_points(file, i, (&offsets, &conn), &mut prev, p.npts, base, &mut c)?;
+            if is_volume_cell(types[i]) {
+                return Err(Error::element(
+                    file,
+                    "cell",
+                    i,
+                    format!(
+                        "a volume cell (VTK type {}): a tet mesh, expected a surface",
+                        types[i]
+                    ),
+                ));
+            }
+            if !is_surface_cell(types[i]) {
+                continue;
+            }
+            if c.len() < 3 {
+                return Err(Error::element(
+                    file,
+                    "cell",
+                    i,
+                    format!("a polygon with {} corners", c.len()),
+                ));
+            }
+            // VTK's quad (9) is a cycle like a polygon, so a fan splits both.
+            let side = match &lab {
+                Some((names, b, f)) => {
+                    let one = |v: i64, k: usize| {
+                        crate::common::side_label_of(v).map_err(|e| {
+                            let n = names[k.min(names.len() - 1)];
+                            Error::element(file, "cell", i, format!("array '{}': {e}", show(n)))
+                        })
+                    };
+                    [one(b[i], 0)?, one(f[i], 1)?]
+                }
+                None => [1, 0],
+            };
+            if c.len() > 3 {
+                split += 1;
+            }
+            for k in 1..c.len() - 1 {
+                triangles.push([c[0], c[k], c[k + 1]]);
+                sides.push(side);
+            }
+        }
+    }
+    let has_labels = labelled == Some(true);
+    Ok(SurfaceRead {
+        mesh: SurfaceMesh::closed(points, triangles, 1),
+        triangle_refs: None,
+        side_labels: has_labels.then_some(sides),
+        welded: 0,
+        polygons_split: split,
+    })
+}
+
+/// Write a surface as VTU (appended raw binary): triangles (VTK type 5) and the cell-data array
+/// `sides` (`Int32`, two components: the regions behind and in front of each triangle).
+pub fn write_surface<W: Write>(w: W, mesh: &SurfaceMesh, file: &str) -> Result<()> {
+    check_surface(mesh, file)?;
+    let nt = mesh.triangles.len();
+    if mesh.sides.len() != nt {
+        return Err(Error::invalid(
+            file,
+            format!("{} side-label pairs for {nt} triangles", mesh.sides.len()),
+        ));
+    }
+    let wide = mesh.points.len() > i32::MAX as usize || 3 * nt > i32::MAX as usize;
+    let (conn, offsets) = if wide {
+        (
+            Data::I64(mesh.triangles.iter().flatten().map(|&v| v as i64).collect()),
+            Data::I64((1..=nt as i64).map(|i| 3 * i).collect()),
+        )
+    } else {
+        (
+            Data::I32(mesh.triangles.iter().flatten().map(|&v| v as i32).collect()),
+            Data::I32((1..=nt as i32).map(|i| 3 * i).collect()),
+        )
+    };
+    let mut sides = Vec::with_capacity(2 * nt);
+    for (t, s) in mesh.sides.iter().enumerate() {
+        for &l in s {
+            sides.push(i32::try_from(l).map_err(|_| {
+                Error::invalid(file, format!("triangle {t}: label {l} does not fit Int32"))
+            })?);
+        }
+    }
+    let a = |name, ncomp, data| Array { name, ncomp, data };
+    let arrays = [
+        a("Points", 3, Data::F64(mesh.points.as_flattened().to_vec())),
+        a("connectivity", 1, conn),
+        a("offsets", 1, offsets),
+        a("types", 1, Data::U8(vec![5; nt])),
+        a("sides", 2, Data::I32(sides)),
+    ];
+    write_grid(
+        w,
+        (mesh.points.len(), nt),
+        &arrays,
+        4,
+        "sides",
+        file,
+        VtuEncoding::Raw,
+    )
 }

@@ -52,6 +52,9 @@ pub struct CheckReport {
     pub boundary_problem: Option<String>,
     /// Surface conformity, when a surface was given.
     pub surface: Option<SurfaceConformity>,
+    /// Per region label (by increasing label): tets, volume, worst angles and, with a surface,
+    /// the volume its triangles enclose. Informational: validity does not depend on it.
+    pub regions: Vec<RegionCheck>,
     /// Human-readable descriptions of the first offenders of each kind.
     pub problems: Vec<String>,
 }
@@ -88,6 +91,82 @@ pub struct InterfaceConformity {
     pub expected: usize,
     /// Of those, present in the mesh as required.
     pub found: usize,
+}
+
+/// One region of a checked mesh: what its tets measure, and what its surface encloses.
+#[derive(Debug, Clone, Default, Serialize, PartialEq)]
+pub struct RegionCheck {
+    /// The label.
+    pub label: u32,
+    /// Its tets.
+    pub n_tets: usize,
+    /// The sum of their signed volumes.
+    pub volume: f64,
+    /// Their smallest dihedral angle (degrees).
+    pub min_dihedral_deg: f64,
+    /// Their largest dihedral angle (degrees).
+    pub max_dihedral_deg: f64,
+    /// Their smallest solid angle (steradians).
+    pub min_solid_angle_sr: f64,
+    /// With a surface: the volume enclosed by the triangles with this label on one side, each
+    /// taken with the region behind it (floating point; equal to `volume` up to rounding when
+    /// the mesh conforms).
+    pub enclosed_volume: Option<f64>,
+}
+
+/// [`RegionCheck`] of every label of `mesh` (tets with an index out of range are skipped), and
+/// of every label of `surface` that has no tets.
+fn region_checks(mesh: &TetMesh, surface: Option<&SurfaceMesh>) -> Vec<RegionCheck> {
+    let mut by_label: std::collections::BTreeMap<u32, RegionCheck> = Default::default();
+    let np = mesh.points.len();
+    for (t, tet) in mesh.tets.iter().enumerate() {
+        if tet.iter().any(|&v| v as usize >= np) {
+            continue;
+        }
+        let label = mesh.labels.get(t).copied().unwrap_or(0);
+        let m = crate::quality::tet::TetMeasures::of(&mesh.corners(t));
+        let r = by_label.entry(label).or_insert_with(|| RegionCheck {
+            label,
+            min_dihedral_deg: f64::INFINITY,
+            max_dihedral_deg: f64::NEG_INFINITY,
+            min_solid_angle_sr: f64::INFINITY,
+            ..Default::default()
+        });
+        r.n_tets += 1;
+        r.volume += m.volume;
+        r.min_dihedral_deg = r.min_dihedral_deg.min(m.min_dihedral());
+        r.max_dihedral_deg = r.max_dihedral_deg.max(m.max_dihedral());
+        r.min_solid_angle_sr = r.min_solid_angle_sr.min(m.min_solid());
+    }
+    if let Some(s) = surface {
+        let o = s.points.first().copied().unwrap_or([0.0; 3]);
+        let mut enclosed: std::collections::BTreeMap<u32, f64> = Default::default();
+        for (t, sides) in s.sides.iter().enumerate().take(s.triangles.len()) {
+            if s.triangles[t].iter().any(|&v| v as usize >= s.points.len()) {
+                continue;
+            }
+            let [a, b, c] = s.corners(t);
+            let v = crate::geom::vec3::volume6(o, a, b, c) / 6.0;
+            for (k, &l) in sides.iter().enumerate() {
+                if l != 0 {
+                    *enclosed.entry(l).or_insert(0.0) += if k == 0 { v } else { -v };
+                }
+            }
+        }
+        for (label, v) in enclosed {
+            by_label
+                .entry(label)
+                .or_insert_with(|| RegionCheck {
+                    label,
+                    min_dihedral_deg: f64::NAN,
+                    max_dihedral_deg: f64::NAN,
+                    min_solid_angle_sr: f64::NAN,
+                    ..Default::default()
+                })
+                .enclosed_volume = Some(v);
+        }
+    }
+    by_label.into_values().collect()
 }
 
 impl CheckReport {
@@ -294,6 +373,7 @@ pub fn check(mesh: &TetMesh, surface: Option<&SurfaceMesh>) -> CheckReport {
         ));
     }
 
+    r.regions = region_checks(mesh, surface);
     let s_ok = r.surface.as_ref().is_none_or(|s| {
         s.n_found == s.n_triangles && s.n_extra_boundary_faces == 0 && s.n_label_mismatch == 0
     });
@@ -562,6 +642,24 @@ impl fmt::Display for CheckReport {
                     writeln!(f, "  {n} {what}")?;
                 }
             }
+        }
+        for g in &self.regions {
+            write!(
+                f,
+                "region {}: {} tets, volume {:.6e}",
+                g.label, g.n_tets, g.volume
+            )?;
+            if let Some(e) = g.enclosed_volume {
+                write!(f, " (its surface encloses {e:.6e})")?;
+            }
+            if g.n_tets > 0 {
+                write!(
+                    f,
+                    ", dihedral {:.2}°–{:.2}°, min solid angle {:.4} sr",
+                    g.min_dihedral_deg, g.max_dihedral_deg, g.min_solid_angle_sr
+                )?;
+            }
+            writeln!(f)?;
         }
         for p in &self.problems {
             writeln!(f, "  - {p}")?;

@@ -2,6 +2,8 @@
 
 use crate::{Common, progress::Stage};
 use anyhow::Result;
+use biotet::SurfaceMesh;
+use biotet::mesh::shells::Part;
 use biotet_io::MeshKind;
 use serde_json::json;
 use std::path::PathBuf;
@@ -13,9 +15,16 @@ pub struct Args {
     /// Input mesh; its format is chosen by extension.
     input: PathBuf,
     /// Output mesh; its format is chosen by extension (.vtu .mesh .msh .node/.ele for tets and
-    /// 2D triangles; .stl .obj .off .ply .mesh for surfaces).
+    /// 2D triangles; .stl .obj .off .ply .mesh .vtu for surfaces).
     #[arg(short, long, value_name = "OUT")]
     output: PathBuf,
+    /// For a surface: label its regions as `biotet mesh` does (closed shells nested innermost
+    /// first, or a non-manifold surface's cells; validated) and write the labels of both sides
+    /// of every triangle (.vtu `sides`, .ply `label_back`/`label_front`, .mesh refs). A surface
+    /// that already has side labels keeps them (checked against the geometry when some side is
+    /// left to it).
+    #[arg(long)]
+    regions: bool,
     #[command(flatten)]
     common: Common,
 }
@@ -37,9 +46,9 @@ pub fn run(a: Args) -> Result<ExitCode> {
             a.output.display()
         );
     }
-    if kind == MeshKind::Surface && ["vtu", "msh", "node", "ele"].contains(&out_ext.as_str()) {
+    if kind == MeshKind::Surface && ["msh", "node", "ele"].contains(&out_ext.as_str()) {
         anyhow::bail!(
-            "{}: {} is a surface; write it as .stl, .obj, .off, .ply or .mesh \
+            "{}: {} is a surface; write it as .stl, .obj, .off, .ply, .mesh or .vtu \
              (meshing a surface is `biotet mesh`, coming with the mesher)",
             a.output.display(),
             a.input.display()
@@ -59,8 +68,34 @@ pub fn run(a: Args) -> Result<ExitCode> {
             ("triangles", m.points.len(), m.triangles.len())
         }
         MeshKind::Surface => {
-            // Conversion keeps the surface as it is (no validation), welded like any read.
-            let m = biotet_io::read_surface(&a.input)?.mesh;
+            // Conversion keeps the surface as it is (no validation), welded like any read;
+            // side labels travel with it.
+            let read = biotet_io::read_surface(&a.input)?;
+            let partial = read.side_labels.as_ref().is_some_and(|s| {
+                s.iter()
+                    .flatten()
+                    .any(|&l| l == biotet::mesh::side_labels::FROM_GEOMETRY)
+            });
+            let m = if read.side_labels.is_some() && (partial || a.regions) {
+                super::input::side_labelled(&a.input, read, a.common)?.0
+            } else if let Some(sides) = read.side_labels {
+                SurfaceMesh { sides, ..read.mesh }
+            } else if a.regions {
+                let part = Part {
+                    surface: read.mesh,
+                    labels: None,
+                };
+                let name = a.input.display().to_string();
+                super::input::assemble_parts(
+                    vec![part],
+                    &name,
+                    std::slice::from_ref(&a.input),
+                    a.common,
+                )?
+                .0
+            } else {
+                read.mesh
+            };
             stage.set(format!("writing {}", a.output.display()));
             biotet_io::write_surface(&a.output, &m)?;
             ("surface triangles", m.points.len(), m.triangles.len())

@@ -4,7 +4,10 @@ use crate::Common;
 use crate::progress::Stage;
 use anyhow::{Context, Result};
 use biotet::mesh::shells::{Part, Shell, assemble};
-use biotet::mesh::validate::{ValidateOptions, ValidationReport, validate_surface};
+use biotet::mesh::side_labels::{self, FROM_GEOMETRY};
+use biotet::mesh::validate::{
+    ValidateOptions, ValidationReport, check_self_intersections, validate_surface,
+};
 use biotet::{SurfaceMesh, TetMesh};
 use std::path::{Path, PathBuf};
 
@@ -32,9 +35,14 @@ pub fn tet_mesh(path: &Path, common: Common) -> Result<TetMesh> {
 }
 
 /// Read and validate a closed surface. Refuses invalid surfaces with an error naming the file;
-/// flips an inward-oriented surface and says so.
+/// flips an inward-oriented surface and says so. A file with side labels is checked as
+/// [`side_labelled`] does.
 pub fn surface(path: &Path, common: Common) -> Result<(SurfaceMesh, ValidationReport)> {
     let read = biotet_io::read_surface(path)?;
+    if read.side_labels.is_some() {
+        let (mesh, _, report) = side_labelled(path, read, common)?;
+        return Ok((mesh, report));
+    }
     let mut mesh = read.mesh;
     let report = validate_surface(&mut mesh, &ValidateOptions::default())
         .with_context(|| format!("{}: invalid surface", path.display()))?;
@@ -56,6 +64,57 @@ pub fn surface(path: &Path, common: Common) -> Result<(SurfaceMesh, ValidationRe
         }
     }
     Ok((mesh, report))
+}
+
+/// A surface whose file gives the region labels on both sides of its triangles (see
+/// `biotet::mesh::side_labels`): the per-region checks of `validate_surface` (closed,
+/// consistently oriented, no crossing triangles) and the labels against the cells of the
+/// geometry. Errors name the file, the triangle and the reason.
+pub fn side_labelled(
+    path: &Path,
+    read: biotet_io::SurfaceRead,
+    common: Common,
+) -> Result<(SurfaceMesh, Vec<Shell>, ValidationReport)> {
+    let name = path.display().to_string();
+    let mut mesh = read.mesh;
+    mesh.sides = read.side_labels.unwrap_or_default();
+    let partial = mesh.sides.iter().flatten().any(|&l| l == FROM_GEOMETRY);
+    let invalid = || format!("{name}: invalid surface");
+    let opts = ValidateOptions::default();
+    let mut report = None;
+    if partial {
+        // Fronts come from the cells, which need triangles that do not cross.
+        check_self_intersections(&mesh, opts.max_examples).with_context(invalid)?;
+    } else {
+        report = Some(validate_surface(&mut mesh, &opts).with_context(invalid)?);
+    }
+    let resolved = side_labels::resolve(&mesh)
+        .with_context(|| format!("{name}: side labels disagree with the geometry"))?;
+    let mut mesh = resolved.surface;
+    let report = match report {
+        Some(r) => r,
+        None => validate_surface(&mut mesh, &opts).with_context(invalid)?,
+    };
+    if !common.quiet && !common.json {
+        if report.flipped_inward {
+            eprintln!(
+                "note: {name}: {} of {} triangles faced inward and were flipped",
+                report.n_flipped_triangles, report.n_triangles
+            );
+        }
+        if resolved.n_from_geometry > 0 {
+            eprintln!(
+                "note: {name}: {} triangle sides took their region from the geometry",
+                resolved.n_from_geometry
+            );
+        }
+        let regions: Vec<String> = mesh.regions().iter().map(|r| r.to_string()).collect();
+        eprintln!(
+            "note: {name}: side labels read from the file, regions {}",
+            regions.join(", ")
+        );
+    }
+    Ok((mesh, resolved.shells, report))
 }
 
 /// `--label FILE=N[,N...]` as labels per input file.
@@ -89,6 +148,24 @@ pub fn labelled_surface(
     for (i, p) in paths.iter().enumerate() {
         stage.set(format!("reading {}", p.display()));
         let read = biotet_io::read_surface(p)?;
+        if read.side_labels.is_some() {
+            if paths.len() > 1 {
+                anyhow::bail!(
+                    "{}: a surface with side labels holds every region and must be given alone",
+                    p.display()
+                );
+            }
+            if labels[i].is_some() {
+                anyhow::bail!(
+                    "{}: --label does not apply: the file gives the region on each side of \
+                     every triangle",
+                    p.display()
+                );
+            }
+            stage.set("validating the surface");
+            let (s, shells, _) = side_labelled(p, read, common)?;
+            return Ok((s, shells, p.display().to_string()));
+        }
         if read.welded > 0 && !common.quiet && !common.json {
             eprintln!(
                 "note: {}: welded {} duplicate vertices",

@@ -2,8 +2,9 @@
 
 use crate::{Common, plot, progress::Stage};
 use anyhow::Result;
-use biotet::quality::{QualityReport, TriQualityReport};
+use biotet::quality::{QualityReport, TriQualityReport, forced};
 use biotet_io::MeshKind;
+use serde_json::json;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -15,6 +16,12 @@ pub struct Args {
     /// Also draw the dihedral- and solid-angle histograms (angle histogram in 2D) to this SVG.
     #[arg(long, value_name = "FILE")]
     svg: Option<PathBuf>,
+    /// The input surface (repeat for several, read as `biotet mesh` reads them): also split the
+    /// quality by where each tet is (a face on the surface, a vertex only, interior) and count
+    /// the tets forced poor by the input (a face that is an input triangle with an angle under
+    /// 10°, or an input edge where the surface folds under 10°). Tet meshes only.
+    #[arg(long = "surface", short = 's', value_name = "SURFACE")]
+    surfaces: Vec<PathBuf>,
     #[command(flatten)]
     common: Common,
 }
@@ -36,6 +43,9 @@ pub fn run(a: Args) -> Result<ExitCode> {
         );
     }
     if kind == MeshKind::Triangles2d {
+        if !a.surfaces.is_empty() {
+            anyhow::bail!("{}: --surface applies to tet meshes only", a.mesh.display());
+        }
         let mesh = biotet_io::read_tri_mesh(&a.mesh)?;
         stage.set("measuring");
         let report = TriQualityReport::of(&mesh);
@@ -46,15 +56,75 @@ pub fn run(a: Args) -> Result<ExitCode> {
         print(&report, a.common)?;
     } else {
         let mesh = super::input::tet_mesh(&a.mesh, a.common)?;
+        let surface = super::input::surfaces(&a.surfaces, a.common, &stage)?;
         stage.set("measuring");
         let report = QualityReport::of(&mesh);
+        let placement = surface.map(|s| {
+            let f = forced::classify(&mesh, &s, FORCED_DEG);
+            (
+                forced::placement_quality(&mesh, &f),
+                forced::summarise(&mesh, &f, FORCED_DEG),
+            )
+        });
         drop(stage);
         if let Some(svg) = &a.svg {
             plot::write_quality_svg(&report, svg, &title)?;
         }
-        print(&report, a.common)?;
+        match placement {
+            None => print(&report, a.common)?,
+            Some((by_place, forcing)) => print_placement(&report, &by_place, &forcing, a.common)?,
+        }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The angle below which an input triangle or fold forces its tets (as `biotet mesh` reports).
+const FORCED_DEG: f64 = 10.0;
+
+/// The report with the placement split and the forcing: the JSON object gains `placement`,
+/// `forcing`, `n_forced` and `n_unforced_dihedral_lt_10`.
+fn print_placement(
+    report: &QualityReport,
+    by_place: &forced::PlacementQuality,
+    forcing: &forced::ForcingSummary,
+    common: Common,
+) -> Result<()> {
+    if common.json {
+        let mut v = serde_json::to_value(report)?;
+        if let Some(o) = v.as_object_mut() {
+            o.insert("placement".into(), serde_json::to_value(by_place)?);
+            o.insert("forcing".into(), serde_json::to_value(forcing)?);
+            o.insert("n_forced".into(), json!(forcing.n_forced));
+            o.insert(
+                "n_unforced_dihedral_lt_10".into(),
+                json!(forcing.n_unforced_dihedral_lt_10),
+            );
+        }
+        crate::emit(&serde_json::to_string_pretty(&v)?);
+    } else if !common.quiet {
+        let deg = |x: Option<f64>| x.map_or("–".to_string(), |d| format!("{d:.3}°"));
+        let mut text = format!("{report}\nby placement (tets, min dihedral, below 10°, forced):\n");
+        for (name, c) in [
+            ("face on the surface", &by_place.face),
+            ("vertex on the surface", &by_place.vertex),
+            ("interior", &by_place.interior),
+        ] {
+            text += &format!(
+                "  {name:<22} {:>9} {:>11} {:>9} {:>9}\n",
+                c.n_tets,
+                deg(c.min_dihedral_deg),
+                c.n_dihedral_lt_10,
+                c.n_forced
+            );
+        }
+        text += &format!(
+            "forced by the input (a face or fold under {FORCED_DEG}°): {} tets; unforced tets \
+             below 10°: {}",
+            forcing.n_forced, forcing.n_unforced_dihedral_lt_10
+        );
+        crate::emit(&text);
+    }
+    Ok(())
 }
 
 fn print<R: serde::Serialize + std::fmt::Display>(report: &R, common: Common) -> Result<()> {

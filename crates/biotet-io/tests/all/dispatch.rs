@@ -45,7 +45,7 @@ fn unknown_extensions_list_the_supported_ones() {
         .to_string();
     assert_eq!(
         e,
-        "foo.xyz: unknown surface file extension; supported: .stl, .obj, .off, .ply, .mesh"
+        "foo.xyz: unknown surface file extension; supported: .stl, .obj, .off, .ply, .mesh, .vtu"
     );
     let e = biotet_io::write_tet_mesh(Path::new("foo"), &cube6())
         .unwrap_err()

@@ -246,3 +246,115 @@ fn paths_round_trip_and_uppercase() {
         assert_same_surface_geometry(&m, &r.mesh, &format!("{f:?}"));
     }
 }
+
+/// Two triangles back to back on a tetrahedron's faces, labelled: region 2 inside a tet whose
+/// outer faces face region 0, with one face an interface to region 5.
+fn labelled_tet() -> SurfaceMesh {
+    SurfaceMesh {
+        points: vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        triangles: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+        sides: vec![[2, 0], [2, 0], [2, 5], [2, 0]],
+    }
+}
+
+#[test]
+fn side_labels_round_trip_through_ply_vtu_and_medit() {
+    let m = labelled_tet();
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["s.ply", "s.vtu", "s.mesh"] {
+        let p = dir.path().join(name);
+        biotet_io::write_surface(&p, &m).unwrap();
+        let r = biotet_io::read_surface(&p).unwrap();
+        assert_eq!(r.mesh.triangles, m.triangles, "{name}");
+        // Medit writes each triangle with the region behind it (interfaces twice): an outer
+        // triangle's front is left to the geometry.
+        let want: Vec<[u32; 2]> = if name.ends_with(".mesh") {
+            let g = biotet::mesh::side_labels::FROM_GEOMETRY;
+            m.sides
+                .iter()
+                .map(|s| if s[1] == 0 { [s[0], g] } else { *s })
+                .collect()
+        } else {
+            m.sides.clone()
+        };
+        assert_eq!(r.side_labels.as_ref(), Some(&want), "{name}");
+        assert_eq!(
+            biotet_io::mesh_kind(&p).unwrap(),
+            biotet_io::MeshKind::Surface,
+            "{name}"
+        );
+    }
+    let mut b = Vec::new();
+    ply::write_ascii(&mut b, &m, "a.ply").unwrap();
+    assert_eq!(
+        ply::parse(&b, "a.ply").unwrap().side_labels,
+        Some(m.sides.clone())
+    );
+    // An unlabelled surface writes no labels and reads none.
+    let plain = SurfaceMesh::closed(m.points.clone(), m.triangles.clone(), 1);
+    let mut b = Vec::new();
+    ply::write_binary(&mut b, &plain, "p.ply").unwrap();
+    assert_eq!(ply::parse(&b, "p.ply").unwrap().side_labels, None);
+}
+
+#[test]
+fn medit_refs_name_the_region_behind_and_a_second_copy_the_front() {
+    use biotet::mesh::side_labels::FROM_GEOMETRY;
+    let head = "MeshVersionFormatted 2\nDimension 3\nVertices\n4\n0 0 0 0\n1 0 0 0\n0 1 0 0\n0 0 1 0\nTriangles\n";
+    // Once each: fronts from the geometry.
+    let once = format!("{head}4\n1 3 2 2\n1 2 4 2\n1 4 3 2\n2 3 4 7\nEnd\n");
+    let r = medit::parse_surface(once.as_bytes(), "a.mesh").unwrap();
+    assert_eq!(r.side_labels.unwrap()[3], [7, FROM_GEOMETRY]);
+    // The shared face twice, reversed: merged, both sides given.
+    let twice = format!("{head}5\n1 3 2 2\n1 2 4 2\n1 4 3 2\n2 3 4 2\n2 4 3 5\nEnd\n");
+    let r = medit::parse_surface(twice.as_bytes(), "b.mesh").unwrap();
+    assert_eq!(r.mesh.triangles.len(), 4);
+    assert_eq!(r.side_labels.unwrap()[3], [2, 5]);
+    // A copy with the same orientation, or the same ref, is an error naming line and triangle.
+    let same = format!("{head}5\n1 3 2 2\n1 2 4 2\n1 4 3 2\n2 3 4 2\n3 4 2 5\nEnd\n");
+    let e = medit::parse_surface(same.as_bytes(), "c.mesh")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("c.mesh")
+            && e.contains("triangle 4: repeats triangle 3 with the same orientation"),
+        "{e}"
+    );
+    // Refs all equal carry no regions.
+    let plain = format!("{head}4\n1 3 2 1\n1 2 4 1\n1 4 3 1\n2 3 4 1\nEnd\n");
+    assert_eq!(
+        medit::parse_surface(plain.as_bytes(), "d.mesh")
+            .unwrap()
+            .side_labels,
+        None
+    );
+}
+
+#[test]
+fn vtu_side_labels_from_surface_nets_names_and_errors() {
+    let m = labelled_tet();
+    let mut b = Vec::new();
+    biotet_io::vtu::write_surface(&mut b, &m, "s.vtu").unwrap();
+    // VTK's SurfaceNets name for the same two-component array.
+    let at = b.windows(12).position(|w| w == b"Name=\"sides\"").unwrap();
+    let mut text = b[..at].to_vec();
+    text.extend_from_slice(b"Name=\"BoundaryLabels\"");
+    text.extend_from_slice(&b[at + 12..]);
+    let r = biotet_io::vtu::parse_surface(&text, "n.vtu").unwrap();
+    assert_eq!(r.side_labels, Some(m.sides.clone()));
+    // A tet mesh is not a surface.
+    let tet = biotet::TetMesh::new(m.points.clone(), vec![[0, 1, 2, 3]], vec![1]);
+    let mut b = Vec::new();
+    biotet_io::vtu::write_tet(&mut b, &tet, "t.vtu").unwrap();
+    let e = biotet_io::vtu::parse_surface(&b, "t.vtu")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("t.vtu") && e.contains("cell 0") && e.contains("tet mesh"),
+        "{e}"
+    );
+    assert_eq!(
+        biotet_io::vtu::peek_kind(&b, "t.vtu").unwrap(),
+        biotet_io::MeshKind::Tetrahedra
+    );
+}

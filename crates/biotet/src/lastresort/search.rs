@@ -7,8 +7,9 @@
 //! as a recovered surface triangle that the rest of the shell does not close off). A candidate of
 //! an active face `abc` is a tet `abcp` whose fourth point `p` is a cavity point with
 //! 1. `orient3d(a, b, c, p) > 0` (exact);
-//! 2. quality `q` (eq. 4.9) above the threshold ηe (floating point: ranking only; with ηe ≤ 0
-//!    no float test is made at all);
+//! 2. quality `q` (eq. 4.9) above the threshold ηe and, optionally, smallest dihedral angle
+//!    above a floor (floating point: ranking only; with ηe ≤ 0 and no floor no float test is
+//!    made at all);
 //! 3. no other live cavity point in the closed tet (exact, orient3d);
 //! 4. no improper contact with any other active face: for every active face and every face of
 //!    the tet, the exact triangle–triangle test ([`tri_tri`]) reports disjoint, a shared vertex
@@ -46,7 +47,7 @@
 use crate::geom::filter::orient3d;
 use crate::geom::intersect::{TriTri, is_degenerate, seg_tri, tri_tri};
 use crate::geom::predicates::{Sign, in_exact_range};
-use crate::quality::tet::q_measure;
+use crate::quality::tet::{min_dihedral_chord2, q_measure};
 use rustc_hash::FxHashMap;
 use std::cell::Cell;
 use thiserror::Error;
@@ -59,6 +60,10 @@ pub struct SearchOptions {
     /// ηe: candidates need quality q (eq. 4.9) strictly above it. At or below 0, every
     /// positively oriented tet qualifies (decided exactly, no float test).
     pub min_quality: f64,
+    /// Candidates need their smallest dihedral angle strictly above this many degrees (at or
+    /// below 0: no floor). Sliver removal sets it to the cavity's worst angle, so every fill
+    /// found is an improvement and no search is spent on refills that would be rejected.
+    pub min_dihedral: f64,
     /// Node budget for the first fill.
     pub max_nodes: u64,
     /// After the first fill, look for fills with a better worst tet for at most this many more
@@ -70,6 +75,7 @@ impl Default for SearchOptions {
     fn default() -> Self {
         SearchOptions {
             min_quality: 0.0,
+            min_dihedral: 0.0,
             max_nodes: 100_000,
             improve: None,
         }
@@ -236,6 +242,8 @@ pub struct Searcher {
     nodes: u64,
     budget: u64,
     eta: f64,
+    /// The dihedral floor as [`min_dihedral_chord2`] of it; `None` for no floor.
+    floor: Option<f64>,
     improve: Option<u64>,
     scratch: Vec<[u32; 3]>,
     edges: Vec<(u32, u32)>,
@@ -366,6 +374,10 @@ impl Searcher {
     ) -> Result<Fill, SearchError> {
         self.load(points, shell, inner)?;
         self.eta = opts.min_quality;
+        self.floor = (opts.min_dihedral > 0.0).then(|| {
+            let s = (opts.min_dihedral.to_radians() / 2.0).sin();
+            4.0 * s * s
+        });
         self.improve = opts.improve;
         self.budget = opts.max_nodes;
         self.nodes = 0;
@@ -378,6 +390,10 @@ impl Searcher {
         self.worst.push(f64::INFINITY);
         for f in 0..self.faces.len() {
             self.gen_candidates(f);
+            if self.faces[f].live == 0 {
+                // The root prunes at once (fig. 3.5): no need for the other faces' candidates.
+                return Err(SearchError::NoFill { nodes_visited: 1 });
+            }
         }
         let flow = self.dfs();
         if self.have_best {
@@ -769,6 +785,9 @@ impl Searcher {
             let q = q_measure(&corners);
             if (self.eta > 0.0 && q.partial_cmp(&self.eta) != Some(std::cmp::Ordering::Greater))
                 || q <= self.bound
+                || self
+                    .floor
+                    .is_some_and(|f| min_dihedral_chord2(&corners) <= f)
             {
                 continue;
             }

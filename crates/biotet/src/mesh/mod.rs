@@ -7,6 +7,7 @@
 pub mod inside;
 pub mod pslg;
 pub mod shells;
+pub mod side_labels;
 pub mod surface;
 pub mod tet;
 pub mod tri;

@@ -125,36 +125,54 @@ pub(crate) fn sorted3(mut f: [u32; 3]) -> [u32; 3] {
     f
 }
 
-/// Face adjacency of a tet array by sorting face keys: `(neighbors, faces in more than two
-/// tets)`. O(n log n), no hashing, deterministic.
+/// Face adjacency of a tet array: `(neighbors, faces in more than two tets)`. The faces are
+/// bucketed by their smallest corner (a counting sort, linear), and each small bucket is sorted
+/// by its other two corners, so matching faces meet: no hashing, deterministic (the first two
+/// tets of a face, by tet and face index, are paired).
 pub fn face_adjacency(tets: &[[u32; 4]]) -> (Vec<[u32; 4]>, usize) {
-    let mut keys: Vec<([u32; 3], u32)> = Vec::with_capacity(tets.len() * 4);
-    for (t, v) in tets.iter().enumerate() {
-        for (f, l) in TET_FACES.iter().enumerate() {
-            keys.push((
-                sorted3([v[l[0]], v[l[1]], v[l[2]]]),
-                (t as u32) << 2 | f as u32,
-            ));
+    let n_vertices = tets.iter().flatten().max().map_or(0, |&m| m as usize + 1);
+    let mut start = vec![0u32; n_vertices + 1];
+    for v in tets {
+        for l in TET_FACES {
+            let m = v[l[0]].min(v[l[1]]).min(v[l[2]]);
+            start[m as usize + 1] += 1;
         }
     }
-    keys.sort_unstable();
+    for i in 0..n_vertices {
+        start[i + 1] += start[i];
+    }
+    // (other two corners packed, tet << 2 | face), grouped by smallest corner.
+    let mut keys = vec![(0u64, 0u32); tets.len() * 4];
+    let mut fill = start.clone();
+    for (t, v) in tets.iter().enumerate() {
+        for (f, l) in TET_FACES.iter().enumerate() {
+            let [a, b, c] = sorted3([v[l[0]], v[l[1]], v[l[2]]]);
+            let slot = &mut fill[a as usize];
+            keys[*slot as usize] = ((b as u64) << 32 | c as u64, (t as u32) << 2 | f as u32);
+            *slot += 1;
+        }
+    }
     let mut nb = vec![[NO_NEIGHBOR; 4]; tets.len()];
     let mut over = 0;
-    let mut i = 0;
-    while i < keys.len() {
-        let mut j = i + 1;
-        while j < keys.len() && keys[j].0 == keys[i].0 {
-            j += 1;
-        }
-        if j - i >= 2 {
-            let (a, b) = (keys[i].1, keys[i + 1].1);
-            nb[(a >> 2) as usize][(a & 3) as usize] = b >> 2;
-            nb[(b >> 2) as usize][(b & 3) as usize] = a >> 2;
-            if j - i > 2 {
-                over += 1;
+    for w in start.windows(2) {
+        let bucket = &mut keys[w[0] as usize..w[1] as usize];
+        bucket.sort_unstable();
+        let mut i = 0;
+        while i < bucket.len() {
+            let mut j = i + 1;
+            while j < bucket.len() && bucket[j].0 == bucket[i].0 {
+                j += 1;
             }
+            if j - i >= 2 {
+                let (a, b) = (bucket[i].1, bucket[i + 1].1);
+                nb[(a >> 2) as usize][(a & 3) as usize] = b >> 2;
+                nb[(b >> 2) as usize][(b & 3) as usize] = a >> 2;
+                if j - i > 2 {
+                    over += 1;
+                }
+            }
+            i = j;
         }
-        i = j;
     }
     (nb, over)
 }

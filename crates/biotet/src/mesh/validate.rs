@@ -702,6 +702,29 @@ fn rs_vertices(s: &SurfaceMesh, rs: u32) -> [u32; 3] {
 // The validator
 // -------------------------------------------------------------------------------------------
 
+/// Step 5 of [`validate_surface`] alone: any two triangles that meet other than in their
+/// shared vertex or edge ([`SurfaceError::SelfIntersection`], listing up to `max_examples`
+/// pairs). Labels and orientation play no part, so it also serves surfaces whose side labels
+/// are not known yet.
+pub fn check_self_intersections(s: &SurfaceMesh, max_examples: usize) -> Result<(), SurfaceError> {
+    let (count, pairs) = self_intersections(s, max_examples);
+    if count == 0 {
+        return Ok(());
+    }
+    Err(SurfaceError::SelfIntersection {
+        count,
+        first: pairs
+            .iter()
+            .map(|&(a, b)| {
+                PairInfo(
+                    TriangleInfo::new(s, a as usize),
+                    TriangleInfo::new(s, b as usize),
+                )
+            })
+            .collect(),
+    })
+}
+
 /// Validate a surface for meshing, reversing inside-out components in place.
 ///
 /// See the [module documentation](self) for the checks, their order and how regions, shells and
@@ -885,21 +908,7 @@ pub fn validate_surface(
 
     // 5. Self-intersections.
     if opts.self_intersections {
-        let (count, pairs) = self_intersections(s, k);
-        if count > 0 {
-            return Err(SurfaceError::SelfIntersection {
-                count,
-                first: pairs
-                    .iter()
-                    .map(|&(a, b)| {
-                        PairInfo(
-                            TriangleInfo::new(s, a as usize),
-                            TriangleInfo::new(s, b as usize),
-                        )
-                    })
-                    .collect(),
-            });
-        }
+        check_self_intersections(s, k)?;
     }
 
     // 6. Components, shell nesting and orientation.

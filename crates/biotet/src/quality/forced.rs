@@ -18,7 +18,7 @@ use crate::geom::vec3::{cross, dot, norm, sub};
 use crate::mesh::coord_key;
 use crate::mesh::surface::SurfaceMesh;
 use crate::mesh::tet::{TET_EDGES, TET_FACES, TetMesh};
-use crate::quality::tet::dihedral_angles;
+use crate::quality::tet::{TetMeasures, dihedral_angles};
 use crate::quality::tri::min_angle_3d_deg;
 
 /// Where a tet touches the input surface.
@@ -242,4 +242,73 @@ pub fn summarise(mesh: &TetMesh, f: &Forcing, threshold_deg: f64) -> ForcingSumm
         }
     }
     s
+}
+
+/// Quality of the tets of one [`Placement`] class.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct ClassQuality {
+    /// Tets in the class.
+    pub n_tets: usize,
+    /// Forced tets in the class.
+    pub n_forced: usize,
+    /// Smallest dihedral angle (degrees; `None` for an empty class).
+    pub min_dihedral_deg: Option<f64>,
+    /// Largest dihedral angle (degrees).
+    pub max_dihedral_deg: Option<f64>,
+    /// Smallest solid angle (steradians).
+    pub min_solid_angle_sr: Option<f64>,
+    /// Mean q (eq. 4.9).
+    pub mean_q: Option<f64>,
+    /// Tets whose smallest dihedral angle is below 5°.
+    pub n_dihedral_lt_5: usize,
+    /// Tets whose smallest dihedral angle is below 10°.
+    pub n_dihedral_lt_10: usize,
+    /// Tets whose smallest dihedral angle is below 20°.
+    pub n_dihedral_lt_20: usize,
+}
+
+/// Quality split by [`Placement`]: tets with an input triangle as a face, touching the surface
+/// at points only, and away from it.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct PlacementQuality {
+    /// Tets with an input triangle as a face.
+    pub face: ClassQuality,
+    /// Tets touching the surface at a point only.
+    pub vertex: ClassQuality,
+    /// Tets away from the surface.
+    pub interior: ClassQuality,
+}
+
+/// The quality of each placement class of a classification.
+pub fn placement_quality(mesh: &TetMesh, f: &Forcing) -> PlacementQuality {
+    let mut out = PlacementQuality::default();
+    let mut sum_q = [0.0f64; 3];
+    for t in 0..mesh.tets.len() {
+        let m = TetMeasures::of(&mesh.corners(t));
+        let (slot, c) = match f.placement[t] {
+            Placement::Face => (0, &mut out.face),
+            Placement::Vertex => (1, &mut out.vertex),
+            Placement::Interior => (2, &mut out.interior),
+        };
+        let (lo, hi) = (m.min_dihedral(), m.max_dihedral());
+        c.n_tets += 1;
+        c.n_forced += usize::from(f.forced[t]);
+        c.min_dihedral_deg = Some(c.min_dihedral_deg.map_or(lo, |x| x.min(lo)));
+        c.max_dihedral_deg = Some(c.max_dihedral_deg.map_or(hi, |x| x.max(hi)));
+        let s = m.min_solid();
+        c.min_solid_angle_sr = Some(c.min_solid_angle_sr.map_or(s, |x| x.min(s)));
+        c.n_dihedral_lt_5 += usize::from(lo < 5.0);
+        c.n_dihedral_lt_10 += usize::from(lo < 10.0);
+        c.n_dihedral_lt_20 += usize::from(lo < 20.0);
+        sum_q[slot] += m.q;
+    }
+    for (c, s) in [&mut out.face, &mut out.vertex, &mut out.interior]
+        .into_iter()
+        .zip(sum_q)
+    {
+        if c.n_tets > 0 {
+            c.mean_q = Some(s / c.n_tets as f64);
+        }
+    }
+    out
 }

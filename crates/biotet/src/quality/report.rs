@@ -14,6 +14,7 @@ use std::fmt;
 use rustc_hash::FxHashMap;
 use serde::Serialize;
 
+use super::interfaces::{InterfaceFaces, interface_faces};
 use super::tet::{REGULAR_SOLID_ANGLE, TetMeasures};
 use super::tri::TriMeasures;
 use crate::mesh::tet::TetMesh;
@@ -319,6 +320,9 @@ pub struct QualityReport {
     pub worst_tets: Vec<WorstTet>,
     /// One summary per region label, by increasing label.
     pub regions: Vec<RegionQuality>,
+    /// The faces between each pair of labels that meet (`[0, r]`: region r's boundary), by
+    /// increasing pair ([`interface_faces`]).
+    pub interfaces: Vec<InterfaceFaces>,
 }
 
 /// One of the worst tets of a [`QualityReport`].
@@ -484,6 +488,7 @@ impl QualityReport {
                 })
                 .collect(),
             regions,
+            interfaces: interface_faces(mesh),
         }
     }
 }
@@ -877,6 +882,14 @@ impl fmt::Display for QualityReport {
                 num(r.min_q, 4),
                 r.n_inverted
             )?;
+        }
+        for i in &s.interfaces {
+            let name = if i.labels[0] == 0 {
+                format!("boundary of region {}", i.labels[1])
+            } else {
+                format!("interface {}|{}", i.labels[0], i.labels[1])
+            };
+            writeln!(f, "  {name}: {} faces, area {:.6e}", i.n_faces, i.area)?;
         }
         Ok(())
     }

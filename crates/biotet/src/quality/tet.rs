@@ -23,6 +23,39 @@ pub fn dihedral_angles(c: &[[f64; 3]; 4]) -> [f64; 6] {
     out
 }
 
+/// The interior dihedral angle (radians) at edge `e` of [`TET_EDGES`] alone: the same value as
+/// `dihedral_angles(c)[e]`, for callers that need one edge.
+pub fn dihedral_at(c: &[[f64; 3]; 4], e: usize) -> f64 {
+    let f = crate::mesh::tet::TET_FACES;
+    let [k, l] = TET_EDGES[5 - e];
+    let normal = |i: usize| {
+        let (a, b, cc) = (c[f[i][0]], c[f[i][1]], c[f[i][2]]);
+        cross(sub(b, a), sub(cc, a))
+    };
+    let (nk, nl) = (normal(k), normal(l));
+    norm(cross(nk, nl)).atan2(-dot(nk, nl))
+}
+
+/// `4·sin²(θ/2)` of the smallest interior dihedral angle θ: increasing in θ, computed without
+/// trigonometry and without cancellation for small angles (as `|u + v|²` of the two faces' unit
+/// outward normals), for ranking many tets cheaply. 0 for a degenerate tet.
+pub fn min_dihedral_chord2(c: &[[f64; 3]; 4]) -> f64 {
+    let n = face_normals(c);
+    let mut u = [[0.0; 3]; 4];
+    for (ui, ni) in u.iter_mut().zip(&n) {
+        let l = norm(*ni);
+        if l == 0.0 {
+            return 0.0;
+        }
+        *ui = scale(*ni, 1.0 / l);
+    }
+    let mut worst = f64::INFINITY;
+    for [k, l] in TET_EDGES {
+        worst = worst.min(norm2(add(u[k], u[l])));
+    }
+    worst
+}
+
 /// Outward normals (length = twice the face area) of the faces opposite each vertex, for a
 /// positively oriented tet.
 fn face_normals(c: &[[f64; 3]; 4]) -> [[f64; 3]; 4] {
@@ -38,24 +71,51 @@ fn face_normals(c: &[[f64; 3]; 4]) -> [[f64; 3]; 4] {
 /// The four solid angles (steradians) at the vertices, by the Van Oosterom–Strackee formula.
 /// Positive for a positively oriented tet, negative for an inverted one.
 pub fn solid_angles(c: &[[f64; 3]; 4]) -> [f64; 4] {
-    /// The other three vertices of each vertex.
+    let (det, den) = solid_angle_parts(c);
+    den.map(|d| 2.0 * det.atan2(d))
+}
+
+/// The two arguments of the Van Oosterom–Strackee formula: the tet's signed `6·volume` and, at
+/// each vertex, the denominator `|u||v||w| + (u·v)|w| + (u·w)|v| + (v·w)|u|` (u, v, w from the
+/// vertex to the other three), so that `solid_angles(c)[i] == 2.0 * det.atan2(den[i])` bit for
+/// bit (it is how [`solid_angles`] computes them). For callers that can decide a comparison
+/// without the arctangent.
+#[inline]
+pub fn solid_angle_parts(c: &[[f64; 3]; 4]) -> (f64, [f64; 4]) {
+    solid_angle_parts_with(c, &edge_lengths(c))
+}
+
+/// The lengths of the six edges of [`TET_EDGES`], in that order. `|p − q|` and `|q − p|` are the
+/// same float, so one length serves both ends of an edge.
+#[inline]
+pub fn edge_lengths(c: &[[f64; 3]; 4]) -> [f64; 6] {
+    TET_EDGES.map(|[i, j]| norm(sub(c[j], c[i])))
+}
+
+/// [`solid_angle_parts`] with the edge lengths given (`len[e]` of edge `TET_EDGES[e]`, as
+/// [`edge_lengths`] computes them): the same floats, for a caller that knows some lengths
+/// already (a tet with one corner moving keeps three).
+#[inline]
+pub fn solid_angle_parts_with(c: &[[f64; 3]; 4], len: &[f64; 6]) -> (f64, [f64; 4]) {
+    /// The other three vertices of each vertex, and the edges to them.
     const OTHERS: [[usize; 3]; 4] = [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]];
+    const EDGES: [[usize; 3]; 4] = [[0, 1, 2], [0, 3, 4], [1, 3, 5], [2, 4, 5]];
     let det = volume6(c[0], c[1], c[2], c[3]);
-    let mut out = [0.0; 4];
-    for (i, o) in out.iter_mut().enumerate() {
+    let mut den = [0.0; 4];
+    for (i, o) in den.iter_mut().enumerate() {
         let [a, b, d] = OTHERS[i];
         let u = sub(c[a], c[i]);
         let v = sub(c[b], c[i]);
         let w = sub(c[d], c[i]);
-        let (lu, lv, lw) = (norm(u), norm(v), norm(w));
-        let denom = lu * lv * lw + dot(u, v) * lw + dot(u, w) * lv + dot(v, w) * lu;
+        let [eu, ev, ew] = EDGES[i];
+        let (lu, lv, lw) = (len[eu], len[ev], len[ew]);
         // The formula's numerator is the triple product [u v w], which is ±det: −det at vertices 1
         // and 3, whose `OTHERS` order is an odd permutation away from the tet's. The denominator
         // is symmetric in u, v, w, so use det itself: the same sign at every vertex, the sign of
         // the tet's orientation.
-        *o = 2.0 * det.atan2(denom);
+        *o = lu * lv * lw + dot(u, v) * lw + dot(u, w) * lv + dot(v, w) * lu;
     }
-    out
+    (det, den)
 }
 
 /// Signed volume of the tet.

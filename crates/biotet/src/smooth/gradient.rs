@@ -14,13 +14,15 @@
 //! When the free node moves, every solid angle of every tet around it changes, not only the
 //! angle at the node: the function returns the gradients of all four.
 
-use crate::geom::vec3::{add, cross, dot, norm, scale, sub, volume6};
+use crate::geom::vec3::{add, cross, dot, scale, sub, volume6};
 use crate::mesh::tet::TET_FACES;
-use crate::quality::tet::solid_angles;
+use crate::quality::tet::{edge_lengths, solid_angles};
 
 /// The other three local vertices of each local vertex, in the order
 /// [`crate::quality::tet::solid_angles`] uses.
 const OTHERS: [[usize; 3]; 4] = [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]];
+/// The edges of [`crate::mesh::tet::TET_EDGES`] from each local vertex to its `OTHERS`.
+const EDGES: [[usize; 3]; 4] = [[0, 1, 2], [0, 3, 4], [1, 3, 5], [2, 4, 5]];
 
 /// The four solid angles of the tet with corners `c` (exactly the values of
 /// [`crate::quality::tet::solid_angles`]) and the gradient of each with respect to the position
@@ -31,6 +33,12 @@ pub fn solid_angle_gradients(c: &[[f64; 3]; 4], k: usize) -> ([f64; 4], [[f64; 3
 
 /// The gradients of [`solid_angle_gradients`] alone, for a caller that has the angles.
 pub fn gradients(c: &[[f64; 3]; 4], k: usize) -> [[f64; 3]; 4] {
+    gradients_with(c, k, &edge_lengths(c))
+}
+
+/// [`gradients`] with the edge lengths given, as [`edge_lengths`] computes them (the same
+/// floats, without the square roots).
+pub fn gradients_with(c: &[[f64; 3]; 4], k: usize, len: &[f64; 6]) -> [[f64; 3]; 4] {
     let det = volume6(c[0], c[1], c[2], c[3]);
     let f = TET_FACES[k];
     // ∂N/∂c_k = −(outward normal of the face opposite k).
@@ -41,7 +49,8 @@ pub fn gradients(c: &[[f64; 3]; 4], k: usize) -> [[f64; 3]; 4] {
         let u = sub(c[a], c[i]);
         let v = sub(c[b], c[i]);
         let w = sub(c[d], c[i]);
-        let (lu, lv, lw) = (norm(u), norm(v), norm(w));
+        let [eu, ev, ew] = EDGES[i];
+        let (lu, lv, lw) = (len[eu], len[ev], len[ew]);
         let (uv, uw, vw) = (dot(u, v), dot(u, w), dot(v, w));
         let den = lu * lv * lw + uv * lw + uw * lv + vw * lu;
         // ∂D/∂u, ∂D/∂v, ∂D/∂w.

@@ -5,8 +5,12 @@
 //! the cluster (at every corner, not only at the node) as a function of the node's position
 //! (eq. 4.7). `node` raises Φ along the analytic gradient (eq. 4.8; [`gradient`]), or, when
 //! several angles are nearly tied, along the ascent direction of all of them ([`ascent`]).
-//! A sweep visits the movable nodes worst cluster first, Gauss–Seidel style (each node sees its
-//! neighbours' new positions); sweeps repeat until the smallest solid angle of the tets that can
+//! A sweep colours the movable nodes to visit greedily, worst cluster first, so that no two nodes
+//! of a colour share a tet (`colour`); the classes run in colour order, Gauss–Seidel style
+//! between classes (each node sees the new positions of the classes before it), and each class
+//! is computed in parallel (rayon) from the positions before it and applied after. Most refused
+//! trial positions are proved refused by cheap bounds (`screen`) before the exact test. Sweeps
+//! repeat until the smallest solid angle of the tets that can
 //! change stops rising, the largest displacement falls below a fraction of the smallest edge, or
 //! the sweep cap.
 //!
@@ -20,12 +24,16 @@
 //!   (interfaces) — with [`Boundary::Fixed`] never move (bit-identical); with [`Boundary::Slide`]
 //!   they move along the input surface and stay on its triangles up to round-off ([`slide`]),
 //!   while nodes on feature edges and corners, on triple lines, or not at a surface vertex stay.
-//! - Deterministic: one order of operations, so the same input gives the same output bit for bit.
+//! - Deterministic: the same input gives the same output bit for bit, for any number of threads
+//!   (a class's nodes read nothing another of them writes, and every reduction is a minimum or
+//!   runs in a fixed order).
 
 pub mod ascent;
+mod colour;
 pub mod gradient;
 mod node;
 pub mod plane;
+mod screen;
 pub mod slide;
 
 use std::time::Instant;
@@ -36,7 +44,9 @@ use crate::geom::vec3::{norm, sub};
 use crate::mesh::surface::SurfaceMesh;
 use crate::mesh::tet::{NO_NEIGHBOR, TET_EDGES, TetMesh};
 use crate::quality::tet::solid_angles;
-use node::{Cluster, LocalParams, Motion};
+use colour::Colouring;
+use node::{Cluster, LocalParams, Motion, Moved};
+use rayon::prelude::*;
 use slide::SlideSurface;
 
 /// What surface nodes may do.
@@ -344,15 +354,22 @@ pub fn smooth(
     }
 
     // Per-tet minimum solid angle, and the smallest edge.
-    let mut tet_min: Vec<f64> = (0..nt)
-        .map(|t| min4(solid_angles(&mesh.corners(t))))
+    let mut tet_angles: Vec<[f64; 4]> = (0..nt)
+        .into_par_iter()
+        .map(|t| solid_angles(&mesh.corners(t)))
         .collect();
-    for t in 0..nt {
-        let c = mesh.corners(t);
-        for [i, j] in TET_EDGES {
-            report.min_edge = report.min_edge.min(norm(sub(c[i], c[j])));
-        }
-    }
+    let mut tet_min: Vec<f64> = tet_angles.iter().map(|a| min4(*a)).collect();
+    // A minimum: the same float whatever the order of the reduction.
+    report.min_edge = (0..nt)
+        .into_par_iter()
+        .map(|t| {
+            let c = mesh.corners(t);
+            TET_EDGES
+                .iter()
+                .map(|&[i, j]| norm(sub(c[i], c[j])))
+                .fold(f64::INFINITY, f64::min)
+        })
+        .reduce(|| f64::INFINITY, f64::min);
     let improvable: Vec<bool> = mesh
         .tets
         .iter()
@@ -386,8 +403,9 @@ pub fn smooth(
     // Nodes whose cluster changed since their last visit. A node whose cluster did not change
     // would do exactly what it did last time (nothing), so skipping it changes no result.
     let mut touched = vec![true; np];
-    let mut cluster = Cluster::default();
+    let mut colouring = Colouring::default();
     let mut order: Vec<(f64, u32)> = Vec::new();
+    let mut nodes: Vec<u32> = Vec::new();
     let sweeps_clock = Instant::now();
     let mut first_gain: Option<f64> = None;
     for _ in 0..opts.max_sweeps {
@@ -409,37 +427,63 @@ pub fn smooth(
             }
         }
         order.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        nodes.clear();
+        nodes.extend(order.iter().map(|o| o.1));
         let mut moved = 0;
         let mut gain = 0.0;
         let mut max_disp: f64 = 0.0;
-        for &(_, v) in &order {
-            let v = v as usize;
-            let Kind::Motion(motion) = kind[v] else {
-                continue;
-            };
-            let s = &star[start[v] as usize..start[v + 1] as usize];
-            touched[v] = false;
-            cluster.load(&mesh.points, &mesh.tets, s, v as u32);
-            let x0 = mesh.points[v];
-            let Some(m) = cluster.optimise(x0, motion, slide_surface.as_ref(), &params) else {
-                continue;
-            };
-            debug_assert!(m.phi_after > m.phi_before);
-            mesh.points[v] = m.x;
-            if let Some(l) = m.loc {
-                kind[v] = Kind::Motion(Motion::Slide(l));
-            }
-            // The cluster has the star's angles at the new position already.
-            for (&t, m) in s.iter().zip(cluster.tet_minima()) {
-                tet_min[t as usize] = m;
-                for &u in &mesh.tets[t as usize] {
-                    touched[u as usize] = true;
+        for mut class in colouring.classes(&nodes, &start, &star, &mesh.tets) {
+            // No two nodes of a class share a tet: each reads only what the others leave alone,
+            // so the class is computed at once from the positions before it and applied after,
+            // and its order changes nothing: by node index, for the memory's sake.
+            class.sort_unstable();
+            let points = &mesh.points;
+            let tets = &mesh.tets;
+            let angles = &tet_angles;
+            let kinds = &kind;
+            let results: Vec<Option<(Moved, Vec<[f64; 4]>)>> = class
+                .par_iter()
+                .map_init(Cluster::default, |cluster, &v| {
+                    let Kind::Motion(motion) = kinds[v as usize] else {
+                        return None;
+                    };
+                    let s = &star[start[v as usize] as usize..start[v as usize + 1] as usize];
+                    cluster.load(points, tets, angles, s, v);
+                    let m = cluster.optimise(
+                        points[v as usize],
+                        motion,
+                        slide_surface.as_ref(),
+                        &params,
+                    )?;
+                    Some((m, cluster.angles().to_vec()))
+                })
+                .collect();
+            for (&v, r) in class.iter().zip(results) {
+                let v = v as usize;
+                touched[v] = false;
+                let Some((m, new_angles)) = r else {
+                    continue;
+                };
+                debug_assert!(m.phi_after > m.phi_before);
+                let x0 = mesh.points[v];
+                mesh.points[v] = m.x;
+                if let Some(l) = m.loc {
+                    kind[v] = Kind::Motion(Motion::Slide(l));
                 }
+                // The cluster has the star's angles at the new position already.
+                let s = &star[start[v] as usize..start[v + 1] as usize];
+                for (&t, a) in s.iter().zip(new_angles) {
+                    tet_min[t as usize] = min4(a);
+                    tet_angles[t as usize] = a;
+                    for &u in &mesh.tets[t as usize] {
+                        touched[u as usize] = true;
+                    }
+                }
+                gain += m.phi_after - m.phi_before;
+                moved += 1;
+                moved_ever[v] = true;
+                max_disp = max_disp.max(norm(sub(m.x, x0)));
             }
-            gain += m.phi_after - m.phi_before;
-            moved += 1;
-            moved_ever[v] = true;
-            max_disp = max_disp.max(norm(sub(m.x, x0)));
         }
         let (all, imp) = mins(&tet_min);
         report.sweeps += 1;

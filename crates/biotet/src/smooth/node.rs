@@ -10,11 +10,16 @@
 //! It stops when no step improves or after an iteration cap.
 
 use super::ascent::{MAX_ACTIVE, min_norm_point};
-use super::gradient::gradients;
+use super::gradient::gradients_with;
+use super::screen::certainly_rejected;
 use super::slide::{Location, SlideSurface};
 use crate::geom::predicates::{Sign, in_exact_range, orient3d};
 use crate::geom::vec3::{add, dot, norm, norm2, scale, sub};
-use crate::quality::tet::{REGULAR_SOLID_ANGLE, solid_angles};
+use crate::mesh::tet::TET_EDGES;
+use crate::quality::tet::{REGULAR_SOLID_ANGLE, edge_lengths, solid_angle_parts_with};
+
+/// The edges of [`TET_EDGES`] at each local vertex (the three that change when it moves).
+const EDGES_AT: [[usize; 3]; 4] = [[0, 1, 2], [0, 3, 4], [1, 3, 5], [2, 4, 5]];
 
 /// How a node may move.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -41,9 +46,15 @@ pub(crate) struct Cluster {
     /// Corners of each tet of the cluster, the free node's at `local[i]`.
     corners: Vec<[[f64; 3]; 4]>,
     local: Vec<usize>,
+    /// Edge lengths of each tet at the current position (those away from the free node stay).
+    lengths: Vec<[f64; 6]>,
+    /// Edge lengths of each tet at a trial position.
+    trial_lengths: Vec<[f64; 6]>,
     /// The solid angles of each tet at the current position.
     angles: Vec<[f64; 4]>,
     trial: Vec<[f64; 4]>,
+    /// The Van Oosterom–Strackee arguments of each tet at a trial position.
+    parts: Vec<(f64, [f64; 4])>,
     /// Gradients with respect to the free node of each tet's four angles.
     grads: Vec<[[f64; 3]; 4]>,
     /// The angles tied for the minimum: (angle, tet, corner).
@@ -62,16 +73,36 @@ pub(crate) struct Moved {
 }
 
 impl Cluster {
-    /// Load the tets `star` around node `v` of `mesh`.
-    pub fn load(&mut self, points: &[[f64; 3]], tets: &[[u32; 4]], star: &[u32], v: u32) {
+    /// Load the tets `star` around node `v` of a mesh with these points and tets, and
+    /// `angles[t]` the solid angles of tet `t` at those points (as
+    /// [`solid_angles`](crate::quality::tet::solid_angles) computes them).
+    pub fn load(
+        &mut self,
+        points: &[[f64; 3]],
+        tets: &[[u32; 4]],
+        angles: &[[f64; 4]],
+        star: &[u32],
+        v: u32,
+    ) {
         self.corners.clear();
         self.local.clear();
+        self.angles.clear();
+        self.lengths.clear();
         for &t in star {
             let tv = tets[t as usize];
-            self.corners.push(tv.map(|i| points[i as usize]));
+            let c = tv.map(|i| points[i as usize]);
+            self.corners.push(c);
+            self.lengths.push(edge_lengths(&c));
             self.local
                 .push(tv.iter().position(|&i| i == v).unwrap_or(0));
+            self.angles.push(angles[t as usize]);
         }
+    }
+
+    /// The solid angles of each tet of the cluster at the free node's current position (after
+    /// [`Cluster::optimise`]: where it left the node), in the order of the loaded star.
+    pub fn angles(&self) -> &[[f64; 4]] {
+        &self.angles
     }
 
     /// The smallest solid angle of each tet of the cluster at the free node's current position
@@ -82,16 +113,9 @@ impl Cluster {
             .map(|a| a[0].min(a[1]).min(a[2]).min(a[3]))
     }
 
-    /// The cluster's minimum solid angle at the loaded position, `angles` filled.
-    fn measure(&mut self) -> f64 {
-        self.angles.clear();
-        let mut phi = f64::INFINITY;
-        for c in &self.corners {
-            let a = solid_angles(c);
-            phi = phi.min(a[0].min(a[1]).min(a[2]).min(a[3]));
-            self.angles.push(a);
-        }
-        phi
+    /// The cluster's minimum solid angle at the loaded position.
+    fn measure(&self) -> f64 {
+        self.tet_minima().fold(f64::INFINITY, f64::min)
     }
 
     /// Φ at `x` and the cluster's soft measure there, the angles into `trial`, if Φ is strictly
@@ -106,12 +130,28 @@ impl Cluster {
         if !x.iter().all(|&c| c.is_finite() && in_exact_range(c)) {
             return None;
         }
-        self.trial.clear();
-        let mut phi = f64::INFINITY;
-        for (c, &k) in self.corners.iter().zip(&self.local) {
+        self.parts.clear();
+        self.trial_lengths.clear();
+        for ((c, &k), len) in self.corners.iter().zip(&self.local).zip(&self.lengths) {
             let mut c = *c;
             c[k] = x;
-            let a = solid_angles(&c);
+            let mut len = *len;
+            for e in EDGES_AT[k] {
+                let [i, j] = TET_EDGES[e];
+                len[e] = norm(sub(c[j], c[i]));
+            }
+            self.parts.push(solid_angle_parts_with(&c, &len));
+            self.trial_lengths.push(len);
+        }
+        let soft_old = *soft_old.get_or_insert_with(|| soft(&self.angles));
+        // Most trials fail; most failures are proved without an arctangent or a logarithm.
+        if certainly_rejected(&self.parts, floor, soft_old) {
+            return None;
+        }
+        self.trial.clear();
+        let mut phi = f64::INFINITY;
+        for &(det, den) in &self.parts {
+            let a = den.map(|d| 2.0 * det.atan2(d));
             let m = a[0].min(a[1]).min(a[2]).min(a[3]);
             // Also rejects NaN.
             if m.is_nan() || m <= floor {
@@ -125,7 +165,6 @@ impl Cluster {
         // counts for nothing) must not fall. Without it, max-min drags the cluster's other
         // angles down to the minimum and fattens the low end of the histogram.
         let soft_new = soft(&self.trial);
-        let soft_old = *soft_old.get_or_insert_with(|| soft(&self.angles));
         if soft_new.is_nan() || soft_new < soft_old {
             return None;
         }
@@ -175,10 +214,10 @@ impl Cluster {
         for _ in 0..p.max_iterations {
             // Gradients of every angle (for the active set and the step prediction).
             self.grads.clear();
-            for (c, &k) in self.corners.iter().zip(&self.local) {
+            for ((c, &k), len) in self.corners.iter().zip(&self.local).zip(&self.lengths) {
                 let mut c = *c;
                 c[k] = x;
-                self.grads.push(gradients(&c, k));
+                self.grads.push(gradients_with(&c, k, len));
             }
             let normal = match (loc, surface) {
                 (Motion::Slide(l), Some(s)) => Some(s.normal(&l)),
@@ -254,6 +293,7 @@ impl Cluster {
             phi = np;
             soft_x = Some(ns);
             std::mem::swap(&mut self.angles, &mut self.trial);
+            std::mem::swap(&mut self.lengths, &mut self.trial_lengths);
         }
         self.active = active;
         self.g = g;
@@ -279,4 +319,32 @@ fn soft(angles: &[[f64; 4]]) -> f64 {
         }
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::quality::tet::{solid_angle_parts, solid_angles};
+
+    /// The edges at each local vertex are those of `TET_EDGES` containing it, and the parts
+    /// from known lengths are the parts (so the trial angles are `solid_angles` bit for bit).
+    #[test]
+    fn edges_at_and_parts_with_lengths() {
+        for (k, es) in EDGES_AT.iter().enumerate() {
+            let want: Vec<usize> = (0..6).filter(|&e| TET_EDGES[e].contains(&k)).collect();
+            assert_eq!(es.to_vec(), want);
+        }
+        let c = [
+            [0.1, 0.2, 0.3],
+            [1.7, 0.1, -0.2],
+            [0.3, 1.9, 0.05],
+            [0.4, 0.35, 1.3],
+        ];
+        let (det, den) = solid_angle_parts(&c);
+        assert_eq!(solid_angle_parts_with(&c, &edge_lengths(&c)), (det, den));
+        let a = solid_angles(&c);
+        for i in 0..4 {
+            assert_eq!((2.0 * det.atan2(den[i])).to_bits(), a[i].to_bits());
+        }
+    }
 }

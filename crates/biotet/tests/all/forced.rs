@@ -3,7 +3,7 @@
 use crate::common::{cube_surface, cube6, load_stl};
 use biotet::SurfaceMesh;
 use biotet::TetMesh;
-use biotet::quality::forced::{Placement, classify, summarise};
+use biotet::quality::forced::{Placement, classify, placement_quality, summarise};
 
 #[test]
 fn a_good_cube_has_no_forced_tets() {
@@ -61,4 +61,26 @@ fn the_tetgen_brain_mesh_has_forced_tets_from_marching_cubes() {
     // Forced tets are a minority of the poor ones: TetGen leaves unforced slivers too.
     assert!(sum.n_unforced_dihedral_lt_10 > 0, "{sum:?}");
     assert!(sum.n_forced < sum.n_face + sum.n_vertex, "{sum:?}");
+    // The per-placement quality adds up to the summary.
+    let pq = placement_quality(&m, &f);
+    let classes = [&pq.face, &pq.vertex, &pq.interior];
+    assert_eq!(
+        [pq.face.n_tets, pq.vertex.n_tets, pq.interior.n_tets],
+        [sum.n_face, sum.n_vertex, sum.n_interior]
+    );
+    assert_eq!(
+        classes.iter().map(|c| c.n_forced).sum::<usize>(),
+        sum.n_forced
+    );
+    assert_eq!(
+        classes.map(|c| c.n_dihedral_lt_10),
+        sum.dihedral_lt_10_by_placement
+    );
+    // Forced tets touch the surface; every class of this mesh is populated and measured.
+    assert_eq!(pq.interior.n_forced, 0);
+    for c in classes {
+        let q = c.mean_q.unwrap();
+        assert!(q > 0.0 && q <= 1.0, "{c:?}");
+        assert!(c.min_dihedral_deg.unwrap() <= c.max_dihedral_deg.unwrap());
+    }
 }

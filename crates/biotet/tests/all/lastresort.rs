@@ -220,6 +220,51 @@ fn search_improves_worst_quality() {
 }
 
 #[test]
+fn search_dihedral_floor_bounds_every_tet() {
+    // The cube with an inner point: a floor just under the best fill's worst angle keeps a fill,
+    // every tet of it above the floor; a floor at that angle leaves none.
+    let (mut pts, shell) = cube();
+    pts.push([0.3, 0.6, 0.45]);
+    let min_dihedral = |t: &[u32; 4]| {
+        let a = biotet::quality::tet::dihedral_angles(&t.map(|i| pts[i as usize]));
+        a.iter().copied().fold(f64::INFINITY, f64::min).to_degrees()
+    };
+    let all = SearchOptions {
+        improve: Some(1_000_000),
+        ..SearchOptions::default()
+    };
+    let some = fill(&pts, &shell, &[8], &all).unwrap();
+    let floor = 0.5
+        * some
+            .tets
+            .iter()
+            .map(min_dihedral)
+            .fold(f64::INFINITY, f64::min);
+    let opts = SearchOptions {
+        min_dihedral: floor,
+        ..all
+    };
+    let f = fill(&pts, &shell, &[8], &opts).unwrap();
+    assert_fills(&pts, &shell, &[8], &f.tets);
+    let worst = f
+        .tets
+        .iter()
+        .map(min_dihedral)
+        .fold(f64::INFINITY, f64::min);
+    assert!(worst > floor, "{worst} vs floor {floor}");
+    // The best worst angle over every fill is at least this one; a floor at 90° excludes all
+    // (no tet of a cube's points has every dihedral angle above 90°).
+    let none = SearchOptions {
+        min_dihedral: 90.0,
+        ..all
+    };
+    assert!(matches!(
+        fill(&pts, &shell, &[8], &none),
+        Err(SearchError::NoFill { .. })
+    ));
+}
+
+#[test]
 fn search_rejects_bad_input() {
     let (pts, mut shell) = cube();
     assert!(matches!(
@@ -450,6 +495,14 @@ fn recover_and_check(name: &str, s: &SurfaceMesh, mut m: TetMesh, opts: &Recover
     }
     assert!(r.missing_before > 0);
     assert!(r.is_complete(), "{} triangles unrecovered", r.missing_after);
+    // The crossed-tets cavity is tried first and recovers most triangles on these surfaces.
+    assert!(r.crossed_ok <= r.crossed_tried && r.crossed_tried <= r.calls);
+    assert!(
+        2 * r.crossed_ok > r.crossed_tried,
+        "{} of {}",
+        r.crossed_ok,
+        r.crossed_tried
+    );
     assert_eq!(m.points.len(), n_points, "no new points");
     let c = check(&m, Some(s));
     assert!(c.valid, "{c}");
@@ -584,4 +637,31 @@ fn recover_nested_interface_labels() {
     };
     assert!((vol(2) - 1.0).abs() < 1e-12, "{}", vol(2));
     assert!((vol(1) - 26.0).abs() < 1e-12, "{}", vol(1));
+}
+
+#[test]
+fn improve_is_the_same_on_any_number_of_threads() {
+    // A Delaunay mesh of random points is full of slivers; the batched parallel refill must give
+    // bit-identical tets on 1 and 2 threads, and a valid mesh with fewer tets under 10°.
+    use biotet::lastresort::{ImproveOptions, improve};
+    let pts = crate::common::random_points(800, 11);
+    let base = Delaunay::new(&pts).unwrap().to_tet_mesh();
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let mut m = base.clone();
+        let r = pool.install(|| improve(&mut m, &ImproveOptions::default()));
+        (m, r)
+    };
+    let (one, r1) = run(1);
+    let (two, r2) = run(2);
+    assert_eq!(one.tets, two.tets);
+    assert_eq!(r1.n_bad_after, r2.n_bad_after);
+    assert!(r1.star_cavities.accepted > 0, "{r1:?}");
+    assert!(5 * r1.n_bad_after < 4 * r1.n_bad_before, "{r1:?}");
+    let c = check(&one, None);
+    assert!(c.valid, "{c}");
+    assert!((mesh_volume(&one) - mesh_volume(&base)).abs() < 1e-9 * mesh_volume(&base));
 }

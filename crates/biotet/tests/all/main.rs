@@ -9,6 +9,7 @@ mod plane;
 mod predicates;
 mod quality;
 mod shells;
+mod side_labels;
 mod sizing;
 mod sizing_grid;
 mod smooth;

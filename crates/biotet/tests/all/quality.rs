@@ -792,3 +792,44 @@ fn histogram_edges() {
     assert_eq!((h.bin_lo(3), h.bin_hi(3), h.hi), (30.0, 40.0, 180.0));
     assert_eq!(h.occupied(), Some(0..=17));
 }
+
+#[test]
+fn single_edge_dihedral_and_chord_agree_with_all_angles() {
+    // Random tets, slivers and near-flat ones included: `dihedral_at` is `dihedral_angles[e]`,
+    // and `min_dihedral_chord2` is 4·sin²(θ/2) of the smallest angle θ.
+    let mut seed = 7u64;
+    let mut next = || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for k in 0..2000 {
+        let mut c = [[0.0; 3]; 4];
+        for p in &mut c {
+            *p = [next(), next(), next()];
+        }
+        if k % 3 == 0 {
+            // Flatten: the fourth point close to the plane of the first three.
+            let t = 10f64.powi(-(k % 9) - 1);
+            let [a, b, d] = [c[0], c[1], c[2]];
+            for (i, x) in c[3].iter_mut().enumerate() {
+                *x = (a[i] + b[i] + d[i]) / 3.0 * (1.0 - t) + *x * t;
+            }
+        }
+        let all = quality::tet::dihedral_angles(&c);
+        for (e, &a) in all.iter().enumerate() {
+            assert!(
+                (quality::tet::dihedral_at(&c, e) - a).abs() < 1e-12,
+                "{c:?} edge {e}"
+            );
+        }
+        let min = all.iter().copied().fold(f64::INFINITY, f64::min);
+        let chord = quality::tet::min_dihedral_chord2(&c);
+        let want = 4.0 * (min / 2.0).sin().powi(2);
+        assert!(
+            (chord - want).abs() <= 1e-9 * want.max(1e-12),
+            "{chord} vs {want}"
+        );
+    }
+}

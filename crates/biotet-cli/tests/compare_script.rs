@@ -1,0 +1,172 @@
+//! Smoke test of `scripts/compare.py`, the comparison with TetGen, Gmsh, fTetWild and MMG: run on
+//! a tiny sphere with the tools installed here, one repeat. Skipped where Python, numpy or meshio
+//! is absent (the script's anchors need them); CI does not run the full comparison.
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// An icosahedron subdivided twice onto the sphere of radius 10 (320 triangles), as OFF.
+fn icosphere_off() -> String {
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut pts: Vec<[f64; 3]> = vec![
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
+    ];
+    let mut tris: Vec<[usize; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    let project = |p: [f64; 3]| {
+        let n = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+        p.map(|c| 10.0 * c / n)
+    };
+    for p in pts.iter_mut() {
+        *p = project(*p);
+    }
+    for _ in 0..2 {
+        let mut mid = std::collections::HashMap::new();
+        let mut next = Vec::new();
+        for [a, b, c] in tris {
+            let mut m = |i: usize, j: usize| {
+                *mid.entry((i.min(j), i.max(j))).or_insert_with(|| {
+                    let (p, q) = (pts[i], pts[j]);
+                    pts.push(project([0, 1, 2].map(|k| (p[k] + q[k]) / 2.0)));
+                    pts.len() - 1
+                })
+            };
+            let (ab, bc, ca) = (m(a, b), m(b, c), m(c, a));
+            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        }
+        tris = next;
+    }
+    let mut s = format!("OFF\n{} {} 0\n", pts.len(), tris.len());
+    for p in &pts {
+        s += &format!("{} {} {}\n", p[0], p[1], p[2]);
+    }
+    for t in &tris {
+        s += &format!("3 {} {} {}\n", t[0], t[1], t[2]);
+    }
+    s
+}
+
+#[test]
+fn compare_script_runs_every_installed_tool_on_a_small_sphere() {
+    let probe = Command::new("python3")
+        .args(["-c", "import numpy, meshio"])
+        .output();
+    if !probe.is_ok_and(|o| o.status.success()) {
+        eprintln!(
+            "python3 with numpy and meshio not available: skipping the compare.py smoke test"
+        );
+        return;
+    }
+    let script = root().join("scripts/compare.py");
+    let list = Command::new("python3")
+        .arg(&script)
+        .arg("--list-tools")
+        .output()
+        .unwrap();
+    assert!(
+        list.status.success(),
+        "{}",
+        String::from_utf8_lossy(&list.stderr)
+    );
+    let list: Value = serde_json::from_slice(&list.stdout).expect("--list-tools prints JSON");
+    let installed: Vec<String> = list
+        .as_object()
+        .unwrap()
+        .iter()
+        .filter(|(_, why)| why.is_null())
+        .map(|(k, _)| k.clone())
+        .collect();
+    assert!(installed.iter().any(|t| t == "biotet"), "{list}");
+
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("sphere.off"), icosphere_off()).unwrap();
+    let out = Command::new("python3")
+        .current_dir(dir.path())
+        .arg(&script)
+        .args(["sphere.off", "--repeat", "1", "--csv", "out.csv"])
+        .args([
+            "--markdown",
+            "out.md",
+            "--biotet",
+            env!("CARGO_BIN_EXE_biotet"),
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+
+    // One CSV row per installed tool.
+    let csv = std::fs::read_to_string(dir.path().join("out.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    let mut tools: Vec<&str> = rows.iter().map(|r| r[col("tool")]).collect();
+    tools.sort_unstable();
+    let mut installed: Vec<&str> = installed.iter().map(String::as_str).collect();
+    installed.sort_unstable();
+    assert_eq!(tools, installed, "{csv}");
+    assert!(rows.iter().all(|r| r[col("surface")] == "sphere.off"));
+
+    // biotet keeps every one of the 320 triangles and gives a valid mesh; so do the tools that
+    // keep the surface, when they ran.
+    let row = |tool: &str| rows.iter().find(|r| r[col("tool")] == tool);
+    let b = row("biotet").unwrap();
+    assert_eq!(b[col("status")], "ok", "{csv}");
+    assert_eq!(b[col("missing")], "0", "{csv}");
+    assert_eq!(b[col("valid")], "True", "{csv}");
+    assert!(b[col("tets")].parse::<u64>().unwrap() > 0);
+    let forced: u64 = b[col("forced")].parse().unwrap();
+    let face_tets: u64 = b[col("face_tets")].parse().unwrap();
+    // Each triangle is a face of one tet, a tet has at most three; the sphere forces nothing.
+    assert!(3 * face_tets >= 320 && forced == 0, "{csv}");
+    for tool in ["tetgen", "tetgen-O", "gmsh", "mmg"] {
+        if let Some(r) = row(tool).filter(|r| r[col("status")] == "ok") {
+            assert_eq!(r[col("missing")], "0", "{tool}: {csv}");
+        }
+    }
+    let md = std::fs::read_to_string(dir.path().join("out.md")).unwrap();
+    assert!(
+        md.contains("| sphere.off | biotet mesh (defaults) |"),
+        "{md}"
+    );
+}
