@@ -16,19 +16,25 @@
 //! boundary edges are collinear (exact) slides along that line between its neighbours, and corners
 //! (two boundary edges at an angle, or more than two) stay.
 //!
+//! A sweep visits the movable nodes worst cluster first, in colour classes of nodes that share no
+//! triangle (the greedy colouring of the 3D smoothing, [`super::colour`]): each class is optimised
+//! in parallel from the positions before it and applied after, Gauss–Seidel between classes.
+//!
 //! Guarantees: only coordinates change; the smallest angle of the mesh never decreases (every
 //! accepted move raises its cluster's smallest angle, computed by the formula of
 //! [`crate::quality::tri::angles`] at the corner opposite the shortest edge, so up to round-off
 //! when two edges are within round-off of each other); fixed nodes are bit-identical; sliding nodes stay on their line up to
-//! round-off; deterministic.
+//! round-off; deterministic, bit for bit, for any number of threads.
 
 use serde::Serialize;
 
 use super::Boundary;
 use super::ascent::min_norm_point;
+use super::colour::Colouring;
 use crate::geom::predicates::{Sign, orient2d};
 use crate::mesh::tri::TriMesh;
 use crate::quality::tri::angles;
+use rayon::prelude::*;
 
 /// Options of [`smooth_tri`].
 #[derive(Debug, Clone, Serialize)]
@@ -196,6 +202,10 @@ fn angle_gradient(c: &[[f64; 2]; 3], j: usize, k: usize) -> [f64; 2] {
     }
 }
 
+/// A node's accepted move: new position, length of the last accepted step, displacement
+/// relative to its mean edge.
+type Move = ([f64; 2], f64, f64);
+
 struct Smoother<'a> {
     m: &'a mut TriMesh,
     /// Length of each node's last accepted step (0: none yet).
@@ -229,13 +239,15 @@ impl Smoother<'_> {
         Some(m)
     }
 
-    /// Raise the cluster minimum of `v`; returns the displacement.
-    fn optimise(&mut self, v: u32, motion: Motion, o: &PlaneSmoothOptions) -> f64 {
+    /// Raise the cluster minimum of `v` from the current positions (nothing is written): the new
+    /// position, the length of its last accepted step and the displacement relative to the
+    /// node's mean edge; `None` when it does not move.
+    fn optimise(&self, v: u32, motion: Motion, o: &PlaneSmoothOptions) -> Option<Move> {
         let x0 = self.m.points[v as usize];
         let mut x = x0;
-        let Some(mut phi) = self.phi(v, x) else {
-            return 0.0;
-        };
+        let mut last = self.last[v as usize];
+        let phi0 = self.phi(v, x)?;
+        let mut phi = phi0;
         let tol = o.active_tolerance_deg.to_radians();
         // Mean edge length of the node.
         let mut len = 0.0;
@@ -250,7 +262,7 @@ impl Smoother<'_> {
             }
         }
         if cnt == 0.0 {
-            return 0.0;
+            return None;
         }
         let scale = len / cnt;
         let mut tied: Vec<(f64, [f64; 3])> = Vec::with_capacity(8);
@@ -292,7 +304,6 @@ impl Smoother<'_> {
                 break;
             }
             // The first trial: a fraction of the node's edges, or a few times its last step.
-            let last = self.last[v as usize];
             let len0 = if last > 0.0 {
                 (4.0 * last).min(o.step_fraction * scale)
             } else {
@@ -308,7 +319,7 @@ impl Smoother<'_> {
                     x = y;
                     phi = p;
                     accepted = true;
-                    self.last[v as usize] = h * dn;
+                    last = h * dn;
                     break;
                 }
                 h *= 0.5;
@@ -317,8 +328,10 @@ impl Smoother<'_> {
                 break;
             }
         }
-        self.m.points[v as usize] = x;
-        ((x[0] - x0[0]).powi(2) + (x[1] - x0[1]).powi(2)).sqrt() / scale
+        (phi > phi0).then(|| {
+            let disp = ((x[0] - x0[0]).powi(2) + (x[1] - x0[1]).powi(2)).sqrt() / scale;
+            (x, last, disp)
+        })
     }
 }
 
@@ -423,6 +436,7 @@ pub fn smooth_tri_with_segments(
         start,
         star,
     };
+    let mut colouring = Colouring::default();
     let mut moved_ever = vec![false; n];
     let mut dirty = vec![true; n];
     let mut last_min = report.min_angle_before_deg;
@@ -442,9 +456,20 @@ pub fn smooth_tri_with_segments(
             min_angle_deg: 0.0,
         };
         let mut max_disp: f64 = 0.0;
-        for &(_, v) in &order {
-            let disp = s.optimise(v, motion[v as usize], o);
-            if disp > 0.0 {
+        // Colour classes (no two nodes of a class share a triangle), worst first; each class is
+        // optimised in parallel from the positions before it and applied after, so the result
+        // is the same for any number of threads.
+        let nodes: Vec<u32> = order.iter().map(|&(_, v)| v).collect();
+        let classes = colouring.classes(&nodes, &s.start, &s.star, &s.m.triangles);
+        for class in classes {
+            let moves: Vec<(u32, Option<Move>)> = class
+                .par_iter()
+                .map(|&v| (v, s.optimise(v, motion[v as usize], o)))
+                .collect();
+            for (v, m) in moves {
+                let Some((x, last, disp)) = m else { continue };
+                s.m.points[v as usize] = x;
+                s.last[v as usize] = last;
                 sweep.moved += 1;
                 moved_ever[v as usize] = true;
                 max_disp = max_disp.max(disp);

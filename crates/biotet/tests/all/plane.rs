@@ -448,3 +448,28 @@ fn graded_deployment_between_fine_boundary_and_coarse_inside() {
     let fine = run(0.25, None);
     assert!(coarse < graded && graded < fine, "{coarse} {graded} {fine}");
 }
+
+#[test]
+fn plane_smoothing_is_the_same_on_any_number_of_threads() {
+    let (m, _) = table_4_1_mesh();
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let mut mm = m.clone();
+        pool.install(|| {
+            smooth_tri(
+                &mut mm,
+                &PlaneSmoothOptions {
+                    boundary: Boundary::Slide,
+                    ..Default::default()
+                },
+            )
+        });
+        mm
+    };
+    let one = run(1);
+    assert_eq!(one, run(3));
+    assert!(check_tri(&one, None).valid);
+}
