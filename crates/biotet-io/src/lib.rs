@@ -5,6 +5,8 @@
 //! | surface ([`SurfaceMesh`]) | STL `.stl` (ASCII/binary), OBJ `.obj`, OFF `.off`, PLY `.ply` (ASCII/binary LE/BE), Medit `.mesh`, VTU `.vtu` (triangles with side labels) | ✓ | ✓ |
 //! | tet mesh ([`TetMesh`]) | VTU `.vtu`, Medit `.mesh`, Gmsh `.msh` (4.1 ASCII/binary, 2.2 ASCII), TetGen `.node`/`.ele`(/`.face`) | ✓ | ✓ |
 //! | 2D mesh ([`TriMesh`]) | Medit `.mesh` (`Dimension 2`), Triangle `.node`/`.ele` | ✓ | ✓ |
+//! | 2D mesh ([`TriMesh`]) | VTU `.vtu`, Gmsh `.msh` (2.2 ASCII) | | ✓ |
+//! | PSLG ([`biotet::mesh::pslg::Pslg`]) | Triangle `.poly`, `.node`/`.edge`, Medit `.mesh` (`Dimension 2`, `Edges`) ([`poly`]) | ✓ | `.poly` |
 //! | scalar grid ([`ScalarGrid`](biotet::sizing_grid::ScalarGrid)) | VTK ImageData `.vti`, NIfTI-1/2 `.nii`, `.nii.gz` ([`read_scalar_grid`], [`grid`]) | ✓ | |
 //!
 //! The path-based entry points ([`read_surface`], [`write_surface`], [`read_tet_mesh`],
@@ -44,8 +46,10 @@ pub mod grid;
 pub mod medit;
 pub mod obj;
 pub mod off;
+pub mod plane_out;
 pub mod ply;
 pub mod points;
+pub mod poly;
 pub mod stl;
 pub mod tetgen;
 mod text;
@@ -55,6 +59,7 @@ pub mod vtu;
 pub use error::{Error, Result};
 pub use grid::{read_scalar_grid, read_scalar_grid_named};
 pub use points::read_points;
+pub use poly::{PslgRead, is_pslg, read_pslg};
 pub use tetgen::{TetgenFiles, TetgenOptions};
 pub use vtu::VtuEncoding;
 
@@ -173,6 +178,10 @@ pub enum TriFormat {
     Medit,
     /// Triangle `.node`/`.ele`.
     Triangle,
+    /// VTU (write only, see [`plane_out`]).
+    Vtu,
+    /// Gmsh `.msh` 2.2 ASCII (write only, see [`plane_out`]).
+    Gmsh,
 }
 
 /// Supported surface extensions, for messages.
@@ -180,7 +189,7 @@ pub const SURFACE_EXTENSIONS: &str = ".stl, .obj, .off, .ply, .mesh, .vtu";
 /// Supported tet mesh extensions, for messages.
 pub const TET_EXTENSIONS: &str = ".vtu, .mesh, .msh, .node/.ele (TetGen)";
 /// Supported 2D mesh extensions, for messages.
-pub const TRI_EXTENSIONS: &str = ".mesh, .node/.ele (Triangle)";
+pub const TRI_EXTENSIONS: &str = ".mesh, .node/.ele (Triangle); writing also .vtu, .msh";
 const ALL_EXTENSIONS: &str = ".stl, .obj, .off, .ply, .mesh, .vtu, .msh, .node, .ele";
 
 /// The lower-case extension of a path.
@@ -241,6 +250,8 @@ impl TriFormat {
         Ok(match ext(path).as_str() {
             "mesh" => TriFormat::Medit,
             "node" | "ele" => TriFormat::Triangle,
+            "vtu" => TriFormat::Vtu,
+            "msh" => TriFormat::Gmsh,
             _ => {
                 return Err(Error::UnknownExtension {
                     path: name(path),
@@ -393,6 +404,10 @@ pub fn read_tri_mesh_as(path: &Path, format: TriFormat) -> Result<TriRead> {
                 &name(&f.base),
             )
         }
+        TriFormat::Vtu | TriFormat::Gmsh => Err(Error::format(
+            &name(path),
+            "2D meshes are read from .mesh or .node/.ele; .vtu and .msh are written only",
+        )),
     }
 }
 
@@ -420,6 +435,14 @@ pub fn write_tri_mesh_as(path: &Path, mesh: &TriMesh, format: TriFormat) -> Resu
                 tetgen::write_tri(a, b, mesh, &base, TetgenOptions::default())
             })?;
             Ok(paths)
+        }
+        TriFormat::Vtu => {
+            atomic::write_atomic(path, |w| plane_out::write_vtu(w, mesh, &name(path)))?;
+            Ok(vec![path.to_path_buf()])
+        }
+        TriFormat::Gmsh => {
+            atomic::write_atomic(path, |w| plane_out::write_msh(w, mesh, &name(path)))?;
+            Ok(vec![path.to_path_buf()])
         }
     }
 }

@@ -57,6 +57,9 @@ struct Medit {
     tris: Vec<[u32; 3]>,
     tri_refs: Vec<i64>,
     tri_lines: Vec<usize>,
+    edges: Vec<[u32; 2]>,
+    edge_refs: Vec<i64>,
+    edge_lines: Vec<usize>,
     tets: Vec<[u32; 4]>,
     tet_refs: Vec<i64>,
     tet_lines: Vec<usize>,
@@ -114,6 +117,9 @@ fn parse(data: &[u8], file: &str) -> Result<Medit> {
         tris: Vec::new(),
         tri_refs: Vec::new(),
         tri_lines: Vec::new(),
+        edges: Vec::new(),
+        edge_refs: Vec::new(),
+        edge_lines: Vec::new(),
         tets: Vec::new(),
         tet_refs: Vec::new(),
         tet_lines: Vec::new(),
@@ -179,6 +185,20 @@ fn parse(data: &[u8], file: &str) -> Result<Medit> {
                         &mut m.tet_lines,
                     )?;
                 }
+            }
+            b"edges" => {
+                if !seen_vertices {
+                    return Err(lx.err("'Edges' before 'Vertices'"));
+                }
+                let nv = m.verts.len();
+                cells(
+                    &mut lx,
+                    nv,
+                    "edges",
+                    &mut m.edges,
+                    &mut m.edge_refs,
+                    &mut m.edge_lines,
+                )?;
             }
             b"hexahedra" | b"prisms" | b"pyramids" => {
                 let n = lx.u64("element count")?;
@@ -346,6 +366,34 @@ pub fn parse_tri(data: &[u8], file: &str) -> Result<TriRead> {
         mesh: TriMesh::new(points, tris, labels),
         flipped,
         degenerate,
+    })
+}
+
+/// Parse a 2D Medit file's `Vertices` and `Edges` as a PSLG (edge refs become segment markers).
+pub fn parse_pslg(data: &[u8], file: &str) -> Result<crate::poly::PslgRead> {
+    let m = parse(data, file)?;
+    if m.dim != 2 {
+        return Err(Error::format(
+            file,
+            "a 3D mesh (Dimension 3), expected a 2D boundary (Dimension 2, Edges)",
+        ));
+    }
+    if m.edges.is_empty() {
+        return Err(Error::format(file, "no 'Edges': no boundary segments"));
+    }
+    let markers = m
+        .edge_refs
+        .iter()
+        .map(|&r| r.clamp(i32::MIN as i64, i32::MAX as i64) as i32)
+        .collect();
+    Ok(crate::poly::PslgRead {
+        pslg: biotet::mesh::pslg::Pslg {
+            points: m.verts.iter().map(|p| [p[0], p[1]]).collect(),
+            segments: m.edges,
+            segment_markers: markers,
+            ..Default::default()
+        },
+        files: vec![file.to_string()],
     })
 }
 

@@ -9,12 +9,16 @@
 #![deny(rustdoc::broken_intra_doc_links)]
 
 pub mod check;
+pub mod check2d;
 pub mod delaunay;
+pub mod delaunay2d;
 pub mod geom;
 pub mod lastresort;
 pub mod mesh;
 pub mod pipeline;
+pub mod pipeline2d;
 pub mod quality;
+pub mod recover2d;
 pub mod sizing;
 pub mod sizing_grid;
 pub mod smooth;

@@ -24,6 +24,12 @@ pub struct Args {
 
 /// Run `biotet check`; exits 1 when the mesh is invalid.
 pub fn run(a: Args) -> Result<ExitCode> {
+    if super::plane::is_tri_mesh(&a.mesh) {
+        if a.surfaces.len() > 1 {
+            anyhow::bail!("a 2D mesh takes at most one --surface: the PSLG");
+        }
+        return super::plane::check_cmd(&a.mesh, a.surfaces.first().map(|p| p.as_path()), a.common);
+    }
     let stage = Stage::start(a.common.quiet, format!("reading {}", a.mesh.display()));
     let mesh = super::input::tet_mesh(&a.mesh, a.common)?;
     let surface = if a.surfaces.is_empty() {

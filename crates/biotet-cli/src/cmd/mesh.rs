@@ -33,7 +33,8 @@ pub struct Args {
     /// Closed surfaces (.stl, .obj, .off, .ply, .mesh, .vtu). Every closed shell encloses a
     /// region; a point belongs to the innermost shell around it. Shells are labelled 1, 2, … in
     /// order of files and of shells within a file, unless --label says otherwise. Without a
-    /// surface, the bundled brain example is meshed.
+    /// surface, the bundled brain example is meshed. A 2D planar straight-line graph (.poly,
+    /// .node/.edge, or a Dimension 2 .mesh with Edges) is meshed in 2D (see README "2D meshes").
     surfaces: Vec<PathBuf>,
     /// Labels of one file's shells in order, as FILE=N[,N...] (repeatable); 0 makes a shell a
     /// cavity (not meshed).
@@ -88,6 +89,10 @@ pub struct Args {
     /// Skip smoothing.
     #[arg(long)]
     no_smooth: bool,
+    /// 2D only: triangulate the PSLG's own points (isolated points included) without deploying
+    /// template nodes.
+    #[arg(long)]
+    no_deploy: bool,
     /// Draw the output's dihedral- and solid-angle histograms to this SVG.
     #[arg(long, value_name = "FILE")]
     svg: Option<PathBuf>,
@@ -117,6 +122,28 @@ fn parse_region_sizes(items: &[String]) -> Result<Vec<(u32, f64)>> {
 
 /// Run `biotet mesh`.
 pub fn run(a: Args) -> Result<ExitCode> {
+    if let [input] = &a.surfaces[..]
+        && super::plane::is_pslg(input)
+    {
+        return super::plane::mesh(
+            super::plane::MeshArgs {
+                input,
+                output: a.output.as_deref(),
+                size: a.size,
+                resolution: a.resolution,
+                zone: match a.zone {
+                    ZoneArg::Box => Zone::Box,
+                    ZoneArg::Euclidean => Zone::Euclidean,
+                },
+                max_pixels: a.max_voxels,
+                grading: a.grading,
+                no_smooth: a.no_smooth,
+                no_deploy: a.no_deploy,
+                svg: a.svg.as_deref(),
+            },
+            a.common,
+        );
+    }
     let clock = Instant::now();
     let stage = Stage::start(a.common.quiet, "reading the surface");
     let (surface, shells, name) = if a.surfaces.is_empty() {

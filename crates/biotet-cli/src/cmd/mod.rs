@@ -6,6 +6,7 @@ pub mod delaunay;
 pub mod improve;
 pub mod input;
 pub mod mesh;
+pub mod plane;
 pub mod quality;
 pub mod recover;
 pub mod smooth;

@@ -44,6 +44,18 @@ pub fn unrecovered_lines(r: &RecoverReport) -> impl Iterator<Item = String> + '_
 
 /// Run `biotet recover`.
 pub fn run(a: Args) -> Result<ExitCode> {
+    if super::plane::is_tri_mesh(&a.mesh) {
+        let [pslg] = &a.surfaces[..] else {
+            anyhow::bail!("a 2D mesh takes one --surface: the PSLG (.poly, .node/.edge, .mesh)");
+        };
+        return super::plane::recover_cmd(
+            &a.mesh,
+            pslg,
+            Some(a.output.as_path()),
+            a.keep_outside,
+            a.common,
+        );
+    }
     let stage = Stage::start(a.common.quiet, format!("reading {}", a.mesh.display()));
     let mut mesh = super::input::tet_mesh(&a.mesh, a.common)?;
     let surface = super::input::surfaces(&a.surfaces, a.common, &stage)?.unwrap_or_default();

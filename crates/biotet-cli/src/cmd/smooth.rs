@@ -49,6 +49,21 @@ pub struct Args {
 
 /// Run `biotet smooth`.
 pub fn run(a: Args) -> Result<ExitCode> {
+    if super::plane::is_tri_mesh(&a.mesh) {
+        let slide = matches!(a.boundary, BoundaryArg::Slide);
+        if a.surfaces.len() > 1 {
+            anyhow::bail!("a 2D mesh takes at most one --surface: the PSLG");
+        }
+        return super::plane::smooth_cmd(
+            &a.mesh,
+            a.surfaces.first().map(|p| p.as_path()),
+            slide,
+            a.max_sweeps,
+            &a.output,
+            a.svg.as_deref(),
+            a.common,
+        );
+    }
     if !(0.0..=180.0).contains(&a.feature_angle) {
         anyhow::bail!(
             "--feature-angle {}: expected degrees between 0 and 180",

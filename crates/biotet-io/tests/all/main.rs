@@ -6,6 +6,7 @@ mod dispatch;
 mod external;
 mod grid;
 mod malformed;
+mod pslg;
 mod real_data;
 mod surface;
 mod tet;

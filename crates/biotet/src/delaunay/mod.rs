@@ -88,7 +88,7 @@
 //! - Limits: fewer than 2³¹ − 1 points and 2³⁰ tet slots ([`DelaunayError::TooLarge`]).
 
 mod kernel;
-mod order;
+pub(crate) mod order;
 
 use crate::geom::filter::Grid;
 use crate::geom::predicates::{Sign, orient2d, orient3d};

@@ -129,7 +129,7 @@ fn hilbert_sort(points: &[[f64; 3]], idx: impl Iterator<Item = u32> + Clone) -> 
 }
 
 /// LSD radix sort of u64 keys, 11 bits per pass, skipping digits that are the same in all keys.
-fn radix_sort(keys: &mut Vec<u64>) {
+pub(crate) fn radix_sort(keys: &mut Vec<u64>) {
     if keys.len() < 256 {
         keys.sort_unstable();
         return;

@@ -27,12 +27,12 @@ impl Colouring {
     /// The colour classes of `order` (mesh nodes; each at most once), colouring greedily in that
     /// order; nodes sharing a tet get different colours. The tets around node `v` are
     /// `star[start[v]..start[v + 1]]`. Classes come in colour order, each in `order`'s order.
-    pub fn classes(
+    pub fn classes<const K: usize>(
         &mut self,
         order: &[u32],
         start: &[u32],
         star: &[u32],
-        tets: &[[u32; 4]],
+        tets: &[[u32; K]],
     ) -> Vec<Vec<u32>> {
         let np = start.len().saturating_sub(1);
         if self.colour.len() != np {

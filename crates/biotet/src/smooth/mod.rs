@@ -32,6 +32,7 @@ pub mod ascent;
 mod colour;
 pub mod gradient;
 mod node;
+pub mod plane;
 mod screen;
 pub mod slide;
 

@@ -12,6 +12,7 @@
 //! Interior nodes are strictly inside the surface (exactly decided) and never on it.
 
 pub mod classify;
+pub mod plane;
 pub mod seal;
 pub mod sweep;
 pub mod voxels;
@@ -132,7 +133,7 @@ pub struct Deployment {
 }
 
 /// The largest `m·2^e ≤ x` with an 8-bit mantissa `m` (at most 0.8% below `x`).
-fn dyadic_below(x: f64) -> f64 {
+pub(crate) fn dyadic_below(x: f64) -> f64 {
     if !(x > 0.0 && x.is_finite()) {
         return x;
     }

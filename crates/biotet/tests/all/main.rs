@@ -5,6 +5,7 @@ mod common;
 mod delaunay;
 mod forced;
 mod lastresort;
+mod plane;
 mod predicates;
 mod quality;
 mod shells;
