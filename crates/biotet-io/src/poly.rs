@@ -22,7 +22,7 @@ use biotet::mesh::pslg::{Pslg, RegionPoint};
 
 use crate::common::label_of_f64;
 use crate::error::{Error, Result};
-use crate::tetgen::parse_node;
+use crate::tetgen::{node_section, parse_node};
 use crate::text::Lexer;
 use crate::{atomic, name};
 
@@ -104,21 +104,15 @@ pub fn parse_poly(data: &[u8], file: &str, node: Option<(&[u8], &str)>) -> Resul
     if !lx.line_tokens(&mut toks) {
         return Err(Error::format(file, "empty .poly file"));
     }
-    if toks.len() < 2 {
-        return Err(lx.err("expected '<points> 2 [<attributes> <markers>]'"));
-    }
-    let n = lx.tok_u64(toks[0], "number of points")? as usize;
-    let dim = lx.tok_u64(toks[1], "dimension")?;
-    if dim != 2 {
-        return Err(lx.err(format!("dimension {dim}, expected 2")));
-    }
-    if n > (u32::MAX / 4) as usize {
-        return Err(lx.err(format!("{n} points do not fit 32-bit indices")));
-    }
-    let mut g = Pslg::default();
+    // The point section is a `.node` file's; Triangle lists no points when a sibling `.node`
+    // holds them.
+    let (points, mut base) = node_section::<2>(&mut lx, &mut toks, data.len())?;
+    let mut g = Pslg {
+        points,
+        ..Default::default()
+    };
     let mut files = vec![file.to_string()];
-    let mut base = 0;
-    if n == 0 {
+    if g.points.is_empty() {
         let Some((nd, nf)) = node else {
             return Err(lx.err("no points listed and no .node file next to the .poly"));
         };
@@ -126,35 +120,6 @@ pub fn parse_poly(data: &[u8], file: &str, node: Option<(&[u8], &str)>) -> Resul
         g.points = pts;
         base = b;
         files.push(nf.to_string());
-    } else {
-        for i in 0..n {
-            if !lx.line_tokens(&mut toks) {
-                return Err(Error::truncated(
-                    file,
-                    format!("expected {n} points, found {i}"),
-                ));
-            }
-            if toks.len() < 3 {
-                return Err(lx.err(format!(
-                    "expected '<index> <x> <y>', got {} numbers",
-                    toks.len()
-                )));
-            }
-            let idx = lx.tok_u64(toks[0], "point index")?;
-            if i == 0 {
-                if idx > 1 {
-                    return Err(lx.err(format!("first point index {idx}, expected 0 or 1")));
-                }
-                base = idx;
-            } else if idx != base + i as u64 {
-                return Err(lx.err(format!(
-                    "point index {idx} out of sequence (expected {})",
-                    base + i as u64
-                )));
-            }
-            g.points
-                .push([lx.tok_f64(toks[1], "x")?, lx.tok_f64(toks[2], "y")?]);
-        }
     }
     let np = g.points.len();
     segments(&mut lx, &mut toks, np, base, "segments", &mut g)?;

@@ -87,6 +87,17 @@ pub(crate) fn parse_node<const D: usize>(data: &[u8], file: &str) -> Result<(Vec
     if !lx.line_tokens(&mut toks) {
         return Err(Error::format(file, "empty .node file"));
     }
+    node_section(&mut lx, &mut toks, data.len())
+}
+
+/// The point section of a `.node` file, which also opens a `.poly`: its header line (already in
+/// `toks`: `<points> <dimension> [<attributes> <markers>]`), then one line per point; returns the
+/// points and the first index (0 or 1). `len` is the data's size, to cap the reservation.
+pub(crate) fn node_section<'a, const D: usize>(
+    lx: &mut Lexer<'a>,
+    toks: &mut Vec<&'a [u8]>,
+    len: usize,
+) -> Result<(Vec<[f64; D]>, u64)> {
     if toks.len() < 2 {
         return Err(lx.err("expected '<points> <dimension> [<attributes> <markers>]'"));
     }
@@ -98,12 +109,12 @@ pub(crate) fn parse_node<const D: usize>(data: &[u8], file: &str) -> Result<(Vec
     if n > u32::MAX as usize {
         return Err(lx.err(format!("{n} points do not fit 32-bit indices")));
     }
-    let mut pts = Vec::with_capacity(reserve_cap(n, data.len(), 2 * (D + 1)));
+    let mut pts = Vec::with_capacity(reserve_cap(n, len, 2 * (D + 1)));
     let mut base = 0u64;
     for i in 0..n {
-        if !lx.line_tokens(&mut toks) {
+        if !lx.line_tokens(toks) {
             return Err(Error::truncated(
-                file,
+                lx.file,
                 format!("expected {n} points, found {i}"),
             ));
         }

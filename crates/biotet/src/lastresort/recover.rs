@@ -51,7 +51,7 @@
 //! whose search exhausts its node budget costs up to a few hundred ms.
 
 use super::cells::Cells;
-use super::search::{SearchError, SearchOptions, Searcher, bbox};
+use super::search::{SearchError, SearchOptions, Searcher, bbox, boxes_apart};
 use crate::delaunay::Delaunay;
 use crate::geom::intersect::{TriTri, tri_tri};
 use crate::geom::predicates::{Sign, in_exact_range, orient3d};
@@ -648,7 +648,7 @@ impl<'a> Recovery<'a> {
                 let g = self.mesh.face(t as usize, f);
                 let gp = g.map(|x| self.mesh.points[x as usize]);
                 let (glo, ghi) = bbox(&gp);
-                if (0..3).any(|k| ghi[k] < lo[k] || glo[k] > hi[k]) {
+                if boxes_apart(glo, ghi, lo, hi) {
                     continue;
                 }
                 if tri_tri(&tp, &gp) != TriTri::Improper {

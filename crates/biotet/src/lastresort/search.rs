@@ -343,7 +343,7 @@ pub(super) fn bbox<const N: usize>(c: &[P3; N]) -> (P3, P3) {
 }
 
 #[inline]
-fn boxes_apart(alo: P3, ahi: P3, blo: P3, bhi: P3) -> bool {
+pub(super) fn boxes_apart(alo: P3, ahi: P3, blo: P3, bhi: P3) -> bool {
     (0..3).any(|k| ahi[k] < blo[k] || bhi[k] < alo[k])
 }
 

@@ -11,6 +11,13 @@ pub const TET_FACES: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 
 /// The six edges of a tet as local vertex pairs; edge `e` is opposite edge `5 - e`.
 pub const TET_EDGES: [[usize; 2]; 6] = [[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]];
 
+/// The other three local vertices of each local vertex, in increasing order.
+pub const TET_OTHERS: [[usize; 3]; 4] = [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]];
+
+/// The edges of [`TET_EDGES`] from each local vertex to its [`TET_OTHERS`], in that order (the
+/// three edges that change when the vertex moves).
+pub const TET_EDGES_AT: [[usize; 3]; 4] = [[0, 1, 2], [0, 3, 4], [1, 3, 5], [2, 4, 5]];
+
 /// A tetrahedral mesh: points, positively oriented tets, face adjacency and a region label per
 /// tet.
 ///

@@ -26,13 +26,8 @@ pub fn dihedral_angles(c: &[[f64; 3]; 4]) -> [f64; 6] {
 /// The interior dihedral angle (radians) at edge `e` of [`TET_EDGES`] alone: the same value as
 /// `dihedral_angles(c)[e]`, for callers that need one edge.
 pub fn dihedral_at(c: &[[f64; 3]; 4], e: usize) -> f64 {
-    let f = crate::mesh::tet::TET_FACES;
     let [k, l] = TET_EDGES[5 - e];
-    let normal = |i: usize| {
-        let (a, b, cc) = (c[f[i][0]], c[f[i][1]], c[f[i][2]]);
-        cross(sub(b, a), sub(cc, a))
-    };
-    let (nk, nl) = (normal(k), normal(l));
+    let (nk, nl) = (face_normal(c, k), face_normal(c, l));
     norm(cross(nk, nl)).atan2(-dot(nk, nl))
 }
 
@@ -59,13 +54,15 @@ pub fn min_dihedral_chord2(c: &[[f64; 3]; 4]) -> f64 {
 /// Outward normals (length = twice the face area) of the faces opposite each vertex, for a
 /// positively oriented tet.
 fn face_normals(c: &[[f64; 3]; 4]) -> [[f64; 3]; 4] {
-    let f = crate::mesh::tet::TET_FACES;
-    let mut n = [[0.0; 3]; 4];
-    for (i, l) in f.iter().enumerate() {
-        let (a, b, cc) = (c[l[0]], c[l[1]], c[l[2]]);
-        n[i] = cross(sub(b, a), sub(cc, a));
-    }
-    n
+    [0, 1, 2, 3].map(|i| face_normal(c, i))
+}
+
+/// The outward normal (length twice the area) of the face opposite vertex `i`.
+#[inline]
+fn face_normal(c: &[[f64; 3]; 4], i: usize) -> [f64; 3] {
+    let l = crate::mesh::tet::TET_FACES[i];
+    let (a, b, cc) = (c[l[0]], c[l[1]], c[l[2]]);
+    cross(sub(b, a), sub(cc, a))
 }
 
 /// The four solid angles (steradians) at the vertices, by the Van Oosterom–Strackee formula.
@@ -97,9 +94,7 @@ pub fn edge_lengths(c: &[[f64; 3]; 4]) -> [f64; 6] {
 /// already (a tet with one corner moving keeps three).
 #[inline]
 pub fn solid_angle_parts_with(c: &[[f64; 3]; 4], len: &[f64; 6]) -> (f64, [f64; 4]) {
-    /// The other three vertices of each vertex, and the edges to them.
-    const OTHERS: [[usize; 3]; 4] = [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]];
-    const EDGES: [[usize; 3]; 4] = [[0, 1, 2], [0, 3, 4], [1, 3, 5], [2, 4, 5]];
+    use crate::mesh::tet::{TET_EDGES_AT as EDGES, TET_OTHERS as OTHERS};
     let det = volume6(c[0], c[1], c[2], c[3]);
     let mut den = [0.0; 4];
     for (i, o) in den.iter_mut().enumerate() {

@@ -15,14 +15,8 @@
 //! angle at the node: the function returns the gradients of all four.
 
 use crate::geom::vec3::{add, cross, dot, scale, sub, volume6};
-use crate::mesh::tet::TET_FACES;
+use crate::mesh::tet::{TET_EDGES_AT as EDGES, TET_FACES, TET_OTHERS as OTHERS};
 use crate::quality::tet::{edge_lengths, solid_angles};
-
-/// The other three local vertices of each local vertex, in the order
-/// [`crate::quality::tet::solid_angles`] uses.
-const OTHERS: [[usize; 3]; 4] = [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]];
-/// The edges of [`crate::mesh::tet::TET_EDGES`] from each local vertex to its `OTHERS`.
-const EDGES: [[usize; 3]; 4] = [[0, 1, 2], [0, 3, 4], [1, 3, 5], [2, 4, 5]];
 
 /// The four solid angles of the tet with corners `c` (exactly the values of
 /// [`crate::quality::tet::solid_angles`]) and the gradient of each with respect to the position

@@ -15,11 +15,8 @@ use super::screen::certainly_rejected;
 use super::slide::{Location, SlideSurface};
 use crate::geom::predicates::{Sign, in_exact_range, orient3d};
 use crate::geom::vec3::{add, dot, norm, norm2, scale, sub};
-use crate::mesh::tet::TET_EDGES;
+use crate::mesh::tet::{TET_EDGES, TET_EDGES_AT as EDGES_AT};
 use crate::quality::tet::{REGULAR_SOLID_ANGLE, edge_lengths, solid_angle_parts_with};
-
-/// The edges of [`TET_EDGES`] at each local vertex (the three that change when it moves).
-const EDGES_AT: [[usize; 3]; 4] = [[0, 1, 2], [0, 3, 4], [1, 3, 5], [2, 4, 5]];
 
 /// How a node may move.
 #[derive(Debug, Clone, Copy, PartialEq)]
