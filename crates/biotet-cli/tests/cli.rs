@@ -1,12 +1,10 @@
 //! The `biotet` binary end to end: real files in, exit codes, messages and outputs checked.
 
+mod support;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
+use support::*;
 
 fn example() -> PathBuf {
     root().join("examples/brain_tetgen.node")
@@ -14,30 +12,6 @@ fn example() -> PathBuf {
 
 fn brain_surface() -> PathBuf {
     root().join("tests/data/brain_20k.stl")
-}
-
-fn biotet(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_biotet"))
-        .args(args)
-        .output()
-        .expect("the biotet binary runs")
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().expect("utf-8 path")
-}
-
-fn json_of(out: &Output) -> Value {
-    assert!(
-        out.status.success(),
-        "stderr: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("one JSON object on stdout")
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
 }
 
 #[test]

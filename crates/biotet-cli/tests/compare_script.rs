@@ -2,13 +2,10 @@
 //! a tiny sphere with the tools installed here, one repeat. Skipped where Python, numpy or meshio
 //! is absent (the script's anchors need them); CI does not run the full comparison.
 
+mod support;
 use serde_json::Value;
-use std::path::{Path, PathBuf};
 use std::process::Command;
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
+use support::*;
 
 /// An icosahedron subdivided twice onto the sphere of radius 10 (320 triangles), as OFF.
 fn icosphere_off() -> String {

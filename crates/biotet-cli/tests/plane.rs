@@ -1,29 +1,9 @@
 //! `biotet` on 2D inputs: PSLGs meshed, segments recovered, meshes smoothed and checked, outputs
 //! in every 2D format, byte-identical across runs; bad input gets an error naming file and line.
 
+mod support;
 use serde_json::Value;
-use std::path::Path;
-use std::process::{Command, Output};
-
-fn biotet(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_biotet"))
-        .args(args)
-        .output()
-        .expect("the biotet binary runs")
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().expect("utf-8 path")
-}
-
-fn json_of(out: &Output) -> Value {
-    assert!(
-        out.status.success(),
-        "stderr: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("one JSON object on stdout")
-}
+use support::*;
 
 /// A 10 × 10 square (unit segments) with a square hole, a triangular region 2 inside and an open
 /// polyline.
