@@ -19,8 +19,8 @@ use std::process::ExitCode;
 struct Cli {
     #[command(subcommand)]
     command: Command,
-    /// Worker threads for the parallel stages (smoothing sweeps, surface validation); 0 or
-    /// absent: one per core. Results do not depend on it.
+    /// Worker threads for the parallel stages (sliver removal's cavity searches, smoothing
+    /// sweeps, surface validation); 0 or absent: one per core. Results do not depend on it.
     #[arg(long, global = true, value_name = "N")]
     threads: Option<usize>,
 }
@@ -47,9 +47,9 @@ enum Command {
     Convert(cmd::convert::Args),
     /// The 3D Delaunay tetrahedralization of a point cloud (exact, degenerate-proof).
     Delaunay(cmd::delaunay::Args),
-    /// Mesh the volume inside a closed surface: template node deployment, Delaunay, outside
-    /// removal (and the later stages as they land). Without a surface, meshes the bundled
-    /// brain example.
+    /// Mesh the volume inside closed surfaces (or a 2D PSLG): template node deployment,
+    /// Delaunay, outside removal, boundary recovery, sliver removal, smoothing. Without a
+    /// surface, meshes the bundled brain example.
     Mesh(cmd::mesh::Args),
     /// Raise the smallest solid angles of a tet mesh by moving nodes (surface fixed or sliding).
     Smooth(cmd::smooth::Args),
