@@ -97,7 +97,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
             "{} → {}: {} tets → {}; below the threshold {} → {}\n\
              tets below 5°/10°/20°: {}/{}/{} → {}/{}/{}; min dihedral {:.4}° → {:.4}°\n\
              {} searches (median {:.3} ms, max {:.1} ms): face flips {}/{}, edge removals {}/{}, \
-             cavities {}/{}, grown {}/{} (accepted/tried); {:.2} s",
+             edge cavities {}/{}, corner cavities {}/{}, grown {}/{} (accepted/tried); {:.2} s",
             a.mesh.display(),
             a.output.display(),
             report.n_tets_before,
@@ -119,6 +119,8 @@ pub fn run(a: Args) -> Result<ExitCode> {
             report.face_flips.calls,
             report.edge_removals.accepted,
             report.edge_removals.calls,
+            report.edge_cavities.accepted,
+            report.edge_cavities.calls,
             report.star_cavities.accepted,
             report.star_cavities.calls,
             report.grown_cavities.accepted,
