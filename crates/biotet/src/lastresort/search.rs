@@ -47,6 +47,7 @@
 use crate::geom::filter::orient3d;
 use crate::geom::intersect::{TriTri, is_degenerate, seg_tri, tri_tri};
 use crate::geom::predicates::{Sign, in_exact_range};
+use crate::geom::vec3::{cross, norm, norm2, sub};
 use crate::quality::tet::{min_dihedral_chord2, q_measure};
 use rustc_hash::FxHashMap;
 use std::cell::Cell;
@@ -249,6 +250,8 @@ pub struct Searcher {
     edges: Vec<(u32, u32)>,
     /// Local point ids sorted by coordinates (the duplicate check).
     order: Vec<u32>,
+    /// The root's faces by shape, poorest first.
+    root_order: Vec<(f64, u32)>,
     /// Rows of `orient`: one per triangle met (sorted corners), for the whole call: the points
     /// never move, so an orientation once computed holds for every face, candidate and level.
     rows: FxHashMap<[u32; 3], u32>,
@@ -293,6 +296,12 @@ impl Plane {
 
 /// Sorted corners and whether `f` is an even permutation of them.
 #[inline]
+/// Area over the sum of squared edges (up to a constant): small for a thin triangle.
+fn tri_shape(c: &[P3; 3]) -> f64 {
+    let (u, v, w) = (sub(c[1], c[0]), sub(c[2], c[0]), sub(c[2], c[1]));
+    norm(cross(u, v)) / (norm2(u) + norm2(v) + norm2(w))
+}
+
 fn sort3(f: [u32; 3]) -> ([u32; 3], bool) {
     let [mut a, mut b, mut c] = f;
     let mut even = true;
@@ -388,12 +397,25 @@ impl Searcher {
         self.levels.clear();
         self.worst.clear();
         self.worst.push(f64::INFINITY);
-        for f in 0..self.faces.len() {
-            self.gen_candidates(f);
-            if self.faces[f].live == 0 {
-                // The root prunes at once (fig. 3.5): no need for the other faces' candidates.
-                return Err(SearchError::NoFill { nodes_visited: 1 });
-            }
+        // Poorest faces first: a face with no candidate is most likely a poor one (a tet on a
+        // thin triangle has a small q), and the root prunes at once when one has none (fig.
+        // 3.5), without the other faces' candidates. Most cavities of sliver removal end here
+        // (nested_brain_wm_20k: 6,982 of 9,990), so the order matters; the result does not
+        // depend on it.
+        let mut root = std::mem::take(&mut self.root_order);
+        root.clear();
+        root.extend((0..self.faces.len() as u32).map(|f| {
+            let c = self.faces[f as usize].v.map(|x| self.pts[x as usize]);
+            (tri_shape(&c), f)
+        }));
+        root.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        let empty = root.iter().any(|&(_, f)| {
+            self.gen_candidates(f as usize);
+            self.faces[f as usize].live == 0
+        });
+        self.root_order = root;
+        if empty {
+            return Err(SearchError::NoFill { nodes_visited: 1 });
         }
         let flow = self.dfs();
         if self.have_best {
