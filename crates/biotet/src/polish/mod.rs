@@ -22,6 +22,7 @@ use serde::Serialize;
 
 use crate::lastresort::Searcher;
 use crate::mesh::tet::{NO_NEIGHBOR, TetMesh};
+use crate::quality::tet::min_dihedral_chord2;
 use refill::RefillParams;
 use relocate::StepParams;
 use work::Work;
@@ -210,8 +211,11 @@ pub fn polish(mesh: &mut TetMesh, opts: &PolishOptions) -> PolishReport {
 /// The live unforced tets of `ts` below `thr` degrees with their angle, worst first.
 fn scan(w: &mut Work, ts: impl Iterator<Item = u32>, thr: f64) -> Vec<(f64, u32)> {
     let mut out = Vec::new();
+    // A trigonometry-free screen first (with a margin: the angle decides).
+    let s = (thr.to_radians() / 2.0).sin();
+    let lim = 4.0 * s * s * (1.0 + 1e-6);
     for t in ts {
-        if !w.alive[t as usize] {
+        if !w.alive[t as usize] || min_dihedral_chord2(&w.corners(t)) > lim {
             continue;
         }
         let a = w.min_angle(t);
