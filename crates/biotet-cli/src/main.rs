@@ -48,8 +48,8 @@ enum Command {
     /// The 3D Delaunay tetrahedralization of a point cloud (exact, degenerate-proof).
     Delaunay(cmd::delaunay::Args),
     /// Mesh the volume inside closed surfaces (or a 2D PSLG): template node deployment,
-    /// Delaunay, outside removal, boundary recovery, sliver removal, smoothing. Without a
-    /// surface, meshes the bundled brain example.
+    /// Delaunay, outside removal, boundary recovery, sliver removal, smoothing, polishing.
+    /// Without a surface, meshes the bundled brain example.
     Mesh(cmd::mesh::Args),
     /// Raise the smallest solid angles of a tet mesh by moving nodes (surface fixed or sliding).
     Smooth(cmd::smooth::Args),

@@ -17,6 +17,7 @@ pub mod lastresort;
 pub mod mesh;
 pub mod pipeline;
 pub mod pipeline2d;
+pub mod polish;
 pub mod quality;
 pub mod recover2d;
 pub mod sizing;

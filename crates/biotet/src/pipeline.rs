@@ -15,6 +15,7 @@ use crate::mesh::coord_key;
 use crate::mesh::inside::{Location, RegionLocator, Transitions};
 use crate::mesh::surface::SurfaceMesh;
 use crate::mesh::tet::{NO_NEIGHBOR, TetMesh};
+use crate::polish::{PolishOptions, PolishReport, polish};
 use crate::sizing::Sizing;
 use crate::smooth::{SmoothError, SmoothOptions, SmoothReport, smooth};
 use crate::template::{DeployError, DeployOptions, TemplateStats, deploy};
@@ -31,6 +32,9 @@ pub struct PipelineOptions {
     /// Smoothing (`None` skips it). Surface nodes stay fixed by default, so the surface is kept
     /// exactly.
     pub smooth: Option<SmoothOptions>,
+    /// Polish of the unforced tets still poor after smoothing (`None` skips it). Surface points
+    /// stay.
+    pub polish: Option<PolishOptions>,
 }
 
 impl PipelineOptions {
@@ -40,6 +44,7 @@ impl PipelineOptions {
             recover: None,
             improve: None,
             smooth: None,
+            polish: None,
             ..PipelineOptions::default()
         }
     }
@@ -57,6 +62,7 @@ impl Default for PipelineOptions {
                 skip_above_sr: 0.1,
                 ..SmoothOptions::default()
             }),
+            polish: Some(PolishOptions::default()),
         }
     }
 }
@@ -99,6 +105,8 @@ pub struct MeshReport {
     pub improve: Option<ImproveReport>,
     /// What smoothing did (if it ran).
     pub smooth: Option<SmoothReport>,
+    /// What polishing did (if it ran).
+    pub polish: Option<PolishReport>,
 }
 
 /// Why the pipeline failed.
@@ -248,6 +256,12 @@ pub fn mesh_surface(
         let clock = Instant::now();
         report.smooth = Some(smooth(&mut mesh, Some(surface), o)?);
         stage(&mut report, "smooth", clock);
+    }
+    if let Some(o) = &opts.polish {
+        progress("polishing");
+        let clock = Instant::now();
+        report.polish = Some(polish(&mut mesh, o));
+        stage(&mut report, "polish", clock);
     }
 
     report.missing_triangles = missing_triangles(&mesh, surface);

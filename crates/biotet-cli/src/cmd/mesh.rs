@@ -89,6 +89,10 @@ pub struct Args {
     /// Skip smoothing.
     #[arg(long)]
     no_smooth: bool,
+    /// Skip polishing (the last pass that moves or removes interior points around the unforced
+    /// tets still below 10°).
+    #[arg(long)]
+    no_polish: bool,
     /// 2D only: triangulate the PSLG's own points (isolated points included) without deploying
     /// template nodes.
     #[arg(long)]
@@ -202,6 +206,9 @@ pub fn run(a: Args) -> Result<ExitCode> {
     }
     if a.no_improve {
         opts.improve = None;
+    }
+    if a.no_polish {
+        opts.polish = None;
     }
     let (mesh, report) = mesh_surface(&surface, &sizing, &opts, &mut |s| stage.set(s))
         .with_context(|| name.clone())?;

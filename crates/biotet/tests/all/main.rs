@@ -6,6 +6,7 @@ mod delaunay;
 mod forced;
 mod lastresort;
 mod plane;
+mod polish;
 mod predicates;
 mod quality;
 mod shells;

@@ -1,0 +1,241 @@
+//! Polish: the last pass over the few unforced tets whose smallest dihedral angle is still below
+//! the threshold after sliver removal and smoothing.
+//!
+//! Sliver removal ([`crate::lastresort::improve()`]) has proved, for each of them, that no refill
+//! of its cavity with the existing points beats it, so the points must change. For each such
+//! tet, worst first, and for each of its interior corners:
+//! 1. **move** the corner to raise the smallest dihedral angle of the unforced tets around it
+//!    (`relocate`);
+//!
+//! Surface points (on a boundary or interface face) never move and are never removed; every
+//! accepted change keeps every tet strictly positive (exact `orient3d`) and never lowers a forced
+//! tet below its angle before or the threshold. Sequential and in a fixed order, so the result is
+//! the same for any number of threads.
+
+mod refill;
+mod relocate;
+mod work;
+
+use std::time::Instant;
+
+use serde::Serialize;
+
+use crate::lastresort::Searcher;
+use crate::mesh::tet::{NO_NEIGHBOR, TetMesh};
+use crate::quality::tet::min_dihedral_chord2;
+use refill::RefillParams;
+use relocate::StepParams;
+use work::Work;
+
+/// Options of [`polish`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PolishOptions {
+    /// Unforced tets whose smallest dihedral angle is below this many degrees are polished.
+    pub threshold_deg: f64,
+    /// A tet is forced poor when one of its boundary or interface faces has an angle below this
+    /// many degrees, or the boundary folds to a wedge below it at one of its edges (as in
+    /// [`crate::lastresort::ImproveOptions::forced_deg`]).
+    pub forced_deg: f64,
+    /// Passes over the tets still bad (a pass only revisits tets that changed).
+    pub max_rounds: usize,
+    /// Ascent iterations per point move.
+    pub move_iterations: usize,
+    /// Try removing interior corners (their star refilled without them, every tet above the
+    /// threshold).
+    pub remove: bool,
+    /// Try refilling the tet and its face neighbours (after the moves).
+    pub refill: bool,
+}
+
+impl Default for PolishOptions {
+    fn default() -> PolishOptions {
+        PolishOptions {
+            threshold_deg: 10.0,
+            forced_deg: 10.0,
+            max_rounds: 3,
+            move_iterations: 8,
+            remove: true,
+            refill: true,
+        }
+    }
+}
+
+/// What [`polish`] did.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct PolishReport {
+    /// Unforced tets below the threshold before.
+    pub n_bad_before: usize,
+    /// Unforced tets below the threshold after.
+    pub n_bad_after: usize,
+    /// Point moves tried.
+    pub moves_tried: usize,
+    /// Point moves accepted.
+    pub moves_accepted: usize,
+    /// Point removals (the point's star refilled without it) tried.
+    pub removals_tried: usize,
+    /// Point removals accepted.
+    pub removals_accepted: usize,
+    /// Refills of a bad tet and its face neighbours tried.
+    pub refills_tried: usize,
+    /// Those accepted.
+    pub refills_accepted: usize,
+    /// Unforced tets below the threshold before, by interior corners (see
+    /// [`PolishReport::bad_by_interior_corners`]).
+    pub bad_before_by_interior_corners: [usize; 5],
+    /// The unforced tets still below the threshold by how many interior (movable) corners they
+    /// have: `[0, 1, 2, 3, 4]`.
+    pub bad_by_interior_corners: [usize; 5],
+    /// Smallest dihedral angle of an unforced tet after, degrees.
+    pub min_unforced_deg: Option<f64>,
+    /// Milliseconds spent: `[scan, moves, removals, refills]`.
+    pub ms: [f64; 4],
+    /// Wall seconds.
+    pub seconds: f64,
+}
+
+/// Polish the unforced tets of `mesh` below the threshold (see the module docs). Points on
+/// boundary and interface faces keep their coordinates and index; tet order is not kept.
+pub fn polish(mesh: &mut TetMesh, opts: &PolishOptions) -> PolishReport {
+    let clock = Instant::now();
+    let mut report = PolishReport::default();
+    let mut w = Work::new(mesh, opts.forced_deg);
+    let thr = opts.threshold_deg;
+    let params = StepParams {
+        iterations: opts.move_iterations,
+        step_fraction: 0.25,
+        halvings: 8,
+        tie: 0.5f64.to_radians(),
+    };
+    let n = w.tets.len() as u32;
+    let mut bad = scan(&mut w, 0..n, thr);
+    report.ms[0] = clock.elapsed().as_secs_f64() * 1e3;
+    report.n_bad_before = bad.len();
+    report.bad_before_by_interior_corners = by_interior_corners(&w, &bad);
+    let rp = RefillParams {
+        max_nodes: 100,
+        improve_nodes: 0,
+        max_tets: 200,
+    };
+    let mut searcher = Searcher::new();
+    let mut star = Vec::new();
+    for _ in 0..opts.max_rounds {
+        let mut touched: Vec<u32> = Vec::new();
+        for &(_, t) in &bad {
+            if !w.alive[t as usize] || w.min_angle(t) >= thr {
+                continue;
+            }
+            for v in w.tets[t as usize] {
+                if w.fixed[v as usize] {
+                    continue;
+                }
+                report.moves_tried += 1;
+                let c = Instant::now();
+                let ok = w.relocate(v, thr.to_radians(), &params, &mut star);
+                report.ms[1] += c.elapsed().as_secs_f64() * 1e3;
+                if ok {
+                    report.moves_accepted += 1;
+                    touched.extend_from_slice(&star);
+                }
+                if w.min_angle(t) >= thr {
+                    break;
+                }
+            }
+            if w.min_angle(t) >= thr {
+                continue;
+            }
+            // Remove an interior corner: its star refilled without it, every tet above the
+            // threshold (lower floors find fills that mostly add tets below it, at ten times the
+            // cost).
+            let mut done = false;
+            for v in w.tets[t as usize] {
+                if !opts.remove || w.fixed[v as usize] {
+                    continue;
+                }
+                w.star(v, &mut star);
+                report.removals_tried += 1;
+                let c = Instant::now();
+                let r = w.refill(&mut searcher, star.clone(), Some(v), true, thr, &rp);
+                report.ms[2] += c.elapsed().as_secs_f64() * 1e3;
+                if let Some(ids) = r {
+                    report.removals_accepted += 1;
+                    touched.extend_from_slice(&ids);
+                    done = true;
+                    break;
+                }
+            }
+            if done {
+                continue;
+            }
+            if !opts.refill {
+                continue;
+            }
+            // The tet and its face neighbours, refilled with the moved points (larger cavities,
+            // such as every tet sharing a corner, cost thirty times more for a third more).
+            let mut cav = Vec::new();
+            let label = w.labels[t as usize];
+            cav.push(t);
+            for n in w.nb[t as usize] {
+                if n != NO_NEIGHBOR && w.labels[n as usize] == label && !w.is_forced(n) {
+                    cav.push(n);
+                }
+            }
+            cav.sort_unstable();
+            cav.dedup();
+            report.refills_tried += 1;
+            let c = Instant::now();
+            let r = w.refill(&mut searcher, cav, None, false, thr, &rp);
+            report.ms[3] += c.elapsed().as_secs_f64() * 1e3;
+            if let Some(ids) = r {
+                report.refills_accepted += 1;
+                touched.extend_from_slice(&ids);
+            }
+        }
+        if touched.is_empty() {
+            break;
+        }
+        // Only tets that changed are retried: the others would fail as before.
+        touched.sort_unstable();
+        touched.dedup();
+        bad = scan(&mut w, touched.into_iter(), thr);
+    }
+    let n = w.tets.len() as u32;
+    let bad = scan(&mut w, 0..n, thr);
+    report.n_bad_after = bad.len();
+    report.bad_by_interior_corners = by_interior_corners(&w, &bad);
+    report.min_unforced_deg = bad.first().map(|x| x.0);
+    w.finish(mesh);
+    report.seconds = clock.elapsed().as_secs_f64();
+    report
+}
+
+/// The live unforced tets of `ts` below `thr` degrees with their angle, worst first.
+fn scan(w: &mut Work, ts: impl Iterator<Item = u32>, thr: f64) -> Vec<(f64, u32)> {
+    let mut out = Vec::new();
+    // A trigonometry-free screen first (with a margin: the angle decides).
+    let s = (thr.to_radians() / 2.0).sin();
+    let lim = 4.0 * s * s * (1.0 + 1e-6);
+    for t in ts {
+        if !w.alive[t as usize] || min_dihedral_chord2(&w.corners(t)) > lim {
+            continue;
+        }
+        let a = w.min_angle(t);
+        if a < thr && !w.is_forced(t) {
+            out.push((a, t));
+        }
+    }
+    out.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    out
+}
+
+/// How many of `bad` have 0, 1, 2, 3 or 4 interior corners.
+fn by_interior_corners(w: &Work, bad: &[(f64, u32)]) -> [usize; 5] {
+    let mut out = [0; 5];
+    for &(_, t) in bad {
+        let n = w.tets[t as usize]
+            .iter()
+            .filter(|&&v| !w.fixed[v as usize])
+            .count();
+        out[n] += 1;
+    }
+    out
+}

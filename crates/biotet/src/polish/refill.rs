@@ -1,0 +1,132 @@
+//! Refill a closed cavity with the LAST RESORT search ([`Searcher`]), optionally without one of
+//! its interior points (which is then removed from the mesh).
+//!
+//! The search's dihedral floor is first the threshold (a fill is then accepted at once), then
+//! the cavity's worst tet, so it only explores fills whose every tet beats it; the fill is applied, its forced tets are found (that needs the new adjacency),
+//! and it is kept only if the worst unforced tet rises while no more tets than before fall below
+//! the threshold; otherwise the old tets are put back.
+
+use rustc_hash::FxHashSet;
+
+use crate::lastresort::{SearchOptions, Searcher};
+
+use super::work::{P3, Work};
+use crate::geom::vec3::volume6;
+use crate::quality::tet::min_dihedral_chord2;
+
+/// Search budget of one refill.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct RefillParams {
+    /// Nodes for a first fill.
+    pub max_nodes: u64,
+    /// Extra nodes looking for a better one.
+    pub improve_nodes: u64,
+    /// Cavities with more tets are not searched.
+    pub max_tets: usize,
+}
+
+/// The unforced worst angle, overall worst angle and count below `thr` of `tets`.
+fn judge(w: &mut Work, tets: &[u32], thr: f64) -> (f64, f64, usize) {
+    let (mut unforced, mut all, mut below) = (f64::INFINITY, f64::INFINITY, 0);
+    for &t in tets {
+        let a = w.min_angle(t);
+        all = all.min(a);
+        below += usize::from(a < thr);
+        if !w.is_forced(t) {
+            unforced = unforced.min(a);
+        }
+    }
+    (unforced, all, below)
+}
+
+/// The search's root test, cheaply: every shell face has a point making a tet with it whose
+/// smallest dihedral angle is above `floor` degrees. Such a tet is far from flat, so its
+/// orientation in floating point is certain; without one no fill exists.
+fn every_face_has_candidate(pts: &[P3], shell: &[[u32; 3]], cands: &[u32], floor: f64) -> bool {
+    let s = (floor.to_radians() / 2.0).sin();
+    let lim = 4.0 * s * s;
+    shell.iter().all(|f| {
+        cands.iter().any(|&p| {
+            if f.contains(&p) {
+                return false;
+            }
+            let c = [f[0], f[1], f[2], p].map(|v| pts[v as usize]);
+            volume6(c[0], c[1], c[2], c[3]) > 0.0 && min_dihedral_chord2(&c) > lim
+        })
+    })
+}
+
+impl Work {
+    /// Refill the cavity of `tets` (one label), without point `drop` if given; the new tets when
+    /// accepted. With `perfect_only`, only fills whose every tet is above the threshold are
+    /// searched.
+    pub fn refill(
+        &mut self,
+        searcher: &mut Searcher,
+        tets: Vec<u32>,
+        drop: Option<u32>,
+        perfect_only: bool,
+        thr: f64,
+        p: &RefillParams,
+    ) -> Option<Vec<u32>> {
+        if tets.len() > p.max_tets {
+            return None;
+        }
+        let label = self.labels[tets[0] as usize];
+        if tets.iter().any(|&t| self.labels[t as usize] != label) {
+            return None;
+        }
+        let old = judge(self, &tets, thr);
+        let cav = self.cavity(tets);
+        let on_shell: FxHashSet<u32> = cav.shell.iter().flatten().copied().collect();
+        if drop.is_some_and(|v| on_shell.contains(&v)) {
+            return None;
+        }
+        let mut inner: Vec<u32> = cav
+            .tets
+            .iter()
+            .flat_map(|&t| self.tets[t as usize])
+            .filter(|v| !on_shell.contains(v) && Some(*v) != drop)
+            .collect();
+        inner.sort_unstable();
+        inner.dedup();
+        // First every tet above the threshold (any such fill is accepted), then, unless only that
+        // is wanted, anything above the worst tet.
+        let mut floors = vec![thr];
+        if !perfect_only && old.1 < thr {
+            floors.push(old.1.max(0.0) * (1.0 + 1e-9));
+        }
+        let mut fill = None;
+        let mut cands: Vec<u32> = on_shell
+            .iter()
+            .copied()
+            .chain(inner.iter().copied())
+            .collect();
+        cands.sort_unstable();
+        for floor in floors {
+            if !every_face_has_candidate(&self.pts, &cav.shell, &cands, floor) {
+                continue;
+            }
+            let so = SearchOptions {
+                min_quality: 0.0,
+                min_dihedral: floor,
+                max_nodes: p.max_nodes,
+                improve: Some(p.improve_nodes),
+            };
+            if let Ok(f) = searcher.fill(&self.pts, &cav.shell, &inner, &so) {
+                fill = Some(f);
+                break;
+            }
+        }
+        let fill = fill?;
+        let old_tets: Vec<[u32; 4]> = cav.tets.iter().map(|&t| self.tets[t as usize]).collect();
+        let ids = self.replace(&cav, &fill.tets);
+        let new = judge(self, &ids, thr);
+        if new.0 > old.0 && new.1 >= old.1 && new.2 <= old.2 {
+            return Some(ids);
+        }
+        let back = self.cavity(ids);
+        self.replace(&back, &old_tets);
+        None
+    }
+}

@@ -1,0 +1,336 @@
+//! The mesh being polished: tets with tombstones, adjacency, one incident tet per point, which
+//! points are fixed (on a boundary or interface face) and which tets the input forces poor.
+
+use rustc_hash::FxHashMap;
+
+use crate::mesh::tet::{NO_NEIGHBOR, TET_EDGES, TET_FACES, TetMesh};
+use crate::quality::tet::{dihedral_angles, dihedral_at};
+use crate::quality::tri::min_angle_3d_deg;
+
+pub(super) type P3 = [f64; 3];
+
+/// A closed cavity: its tets, the shell (faces pointing into it) with the tet outside each shell
+/// face and that tet's local face.
+pub(super) struct Cavity {
+    pub tets: Vec<u32>,
+    pub shell: Vec<[u32; 3]>,
+    pub outer: Vec<(u32, u8)>,
+}
+
+pub(super) struct Work {
+    pub pts: Vec<P3>,
+    pub tets: Vec<[u32; 4]>,
+    pub nb: Vec<[u32; 4]>,
+    pub labels: Vec<u32>,
+    pub alive: Vec<bool>,
+    /// One live tet per point ([`NO_NEIGHBOR`] once the point is removed).
+    pub vtet: Vec<u32>,
+    /// Per point: on a boundary or interface face (never moves, never removed).
+    pub fixed: Vec<bool>,
+    /// Per tet: 0 unknown, 1 forced, 2 not forced.
+    forced: Vec<u8>,
+    free: Vec<u32>,
+    forced_deg: f64,
+}
+
+impl Work {
+    pub fn new(mesh: &mut TetMesh, forced_deg: f64) -> Work {
+        let n = mesh.tets.len();
+        let np = mesh.points.len();
+        let mut w = Work {
+            pts: std::mem::take(&mut mesh.points),
+            tets: std::mem::take(&mut mesh.tets),
+            nb: std::mem::take(&mut mesh.neighbors),
+            labels: std::mem::take(&mut mesh.labels),
+            alive: vec![true; n],
+            vtet: vec![NO_NEIGHBOR; np],
+            fixed: vec![false; np],
+            forced: vec![0; n],
+            free: Vec::new(),
+            forced_deg,
+        };
+        for t in 0..n {
+            for (i, f) in TET_FACES.iter().enumerate() {
+                let o = w.nb[t][i];
+                if o == NO_NEIGHBOR || w.labels[o as usize] != w.labels[t] {
+                    for &k in f {
+                        w.fixed[w.tets[t][k] as usize] = true;
+                    }
+                }
+            }
+            for &v in &w.tets[t] {
+                w.vtet[v as usize] = t as u32;
+            }
+        }
+        w
+    }
+
+    /// Put the (compacted) result back into `mesh`: dead tets and removed points dropped, point
+    /// order otherwise kept.
+    pub fn finish(self, mesh: &mut TetMesh) {
+        let mut new_pt = vec![u32::MAX; self.pts.len()];
+        let mut points = Vec::with_capacity(self.pts.len());
+        for (i, p) in self.pts.iter().enumerate() {
+            if self.vtet[i] != NO_NEIGHBOR {
+                new_pt[i] = points.len() as u32;
+                points.push(*p);
+            }
+        }
+        let mut new_tet = vec![NO_NEIGHBOR; self.tets.len()];
+        let mut k = 0u32;
+        for (t, slot) in new_tet.iter_mut().enumerate() {
+            if self.alive[t] {
+                *slot = k;
+                k += 1;
+            }
+        }
+        let (mut tets, mut nb, mut labels) = (Vec::new(), Vec::new(), Vec::new());
+        for t in 0..self.tets.len() {
+            if !self.alive[t] {
+                continue;
+            }
+            tets.push(self.tets[t].map(|v| new_pt[v as usize]));
+            nb.push(self.nb[t].map(|n| {
+                if n == NO_NEIGHBOR {
+                    n
+                } else {
+                    new_tet[n as usize]
+                }
+            }));
+            labels.push(self.labels[t]);
+        }
+        *mesh = TetMesh {
+            points,
+            tets,
+            neighbors: nb,
+            labels,
+        };
+    }
+
+    pub fn corners(&self, t: u32) -> [P3; 4] {
+        self.tets[t as usize].map(|v| self.pts[v as usize])
+    }
+
+    /// The smallest dihedral angle of `t`, degrees.
+    pub fn min_angle(&self, t: u32) -> f64 {
+        min_deg(&self.corners(t))
+    }
+
+    /// Every live tet with corner `v`, across the faces around `v` (all labels).
+    pub fn star(&self, v: u32, out: &mut Vec<u32>) {
+        out.clear();
+        let start = self.vtet[v as usize];
+        if start == NO_NEIGHBOR {
+            return;
+        }
+        out.push(start);
+        let mut i = 0;
+        while i < out.len() {
+            let t = out[i];
+            i += 1;
+            let tv = self.tets[t as usize];
+            for (k, &n) in self.nb[t as usize].iter().enumerate() {
+                // Faces containing v are those opposite the other corners.
+                if tv[k] != v && n != NO_NEIGHBOR && !out.contains(&n) {
+                    out.push(n);
+                }
+            }
+        }
+    }
+
+    /// Whether the input forces `t` poor: a boundary or interface face with an angle below the
+    /// threshold, or a boundary edge where the region's wedge is below it.
+    pub fn is_forced(&mut self, t: u32) -> bool {
+        match self.forced[t as usize] {
+            1 => true,
+            2 => false,
+            _ => {
+                let f = self.compute_forced(t);
+                self.forced[t as usize] = if f { 1 } else { 2 };
+                f
+            }
+        }
+    }
+
+    fn compute_forced(&self, t: u32) -> bool {
+        let tv = self.tets[t as usize];
+        if tv.iter().filter(|&&v| self.fixed[v as usize]).count() < 2 {
+            return false;
+        }
+        let label = self.labels[t as usize];
+        let lim = self.forced_deg;
+        for (i, l) in TET_FACES.iter().enumerate() {
+            let n = self.nb[t as usize][i];
+            if (n == NO_NEIGHBOR || self.labels[n as usize] != label)
+                && min_angle_3d_deg(&l.map(|k| self.pts[tv[k] as usize])) < lim
+            {
+                return true;
+            }
+        }
+        for e in TET_EDGES {
+            let (a, b) = (tv[e[0]], tv[e[1]]);
+            if self.fixed[a as usize]
+                && self.fixed[b as usize]
+                && self.wedge(t, a, b).is_some_and(|w| w.to_degrees() < lim)
+            {
+                return true;
+            }
+        }
+        false
+    }
+
+    /// The region's wedge at edge `ab` of `t` (the sum of the angles there of the region's tets
+    /// around it) when the edge is on the region's boundary; `None` for an interior edge.
+    fn wedge(&self, t: u32, a: u32, b: u32) -> Option<f64> {
+        let label = self.labels[t as usize];
+        let angle_at = |s: u32| {
+            let tv = self.tets[s as usize];
+            let ia = tv.iter().position(|&v| v == a).unwrap_or(0);
+            let ib = tv.iter().position(|&v| v == b).unwrap_or(0);
+            let e = TET_EDGES
+                .iter()
+                .position(|&[x, y]| (x == ia && y == ib) || (x == ib && y == ia))
+                .unwrap_or(0);
+            dihedral_at(&self.corners(s), e)
+        };
+        let mut sum = angle_at(t);
+        let mut open = false;
+        let tv = self.tets[t as usize];
+        for (i, &x) in tv.iter().enumerate() {
+            if x == a || x == b {
+                continue;
+            }
+            let (mut prev, mut s) = (t, self.nb[t as usize][i]);
+            let mut steps = 0;
+            loop {
+                if s == NO_NEIGHBOR || self.labels[s as usize] != label {
+                    open = true;
+                    break;
+                }
+                if s == t || steps > 64 {
+                    return None;
+                }
+                steps += 1;
+                sum += angle_at(s);
+                let v = self.tets[s as usize];
+                let next = (0..4)
+                    .filter(|&k| v[k] != a && v[k] != b)
+                    .map(|k| self.nb[s as usize][k])
+                    .find(|&n| n != prev)
+                    .unwrap_or(NO_NEIGHBOR);
+                prev = s;
+                s = next;
+            }
+        }
+        open.then_some(sum)
+    }
+
+    /// The cavity of `tets` (all of one label).
+    pub fn cavity(&self, tets: Vec<u32>) -> Cavity {
+        let mut shell = Vec::new();
+        let mut outer = Vec::new();
+        for &t in &tets {
+            let v = self.tets[t as usize];
+            for (i, l) in TET_FACES.iter().enumerate() {
+                let n = self.nb[t as usize][i];
+                if n != NO_NEIGHBOR && tets.contains(&n) {
+                    continue;
+                }
+                // Outward face reversed: the normal points into the cavity.
+                shell.push([v[l[0]], v[l[2]], v[l[1]]]);
+                let j = if n == NO_NEIGHBOR {
+                    0
+                } else {
+                    self.nb[n as usize]
+                        .iter()
+                        .position(|&x| x == t)
+                        .unwrap_or(0) as u8
+                };
+                outer.push((n, j));
+            }
+        }
+        Cavity { tets, shell, outer }
+    }
+
+    /// Swap the cavity's tets for `new` (which fill it exactly) and stitch the adjacency; the
+    /// new tets' ids. Points no new tet uses are marked removed when they lose their last tet.
+    pub fn replace(&mut self, cav: &Cavity, new: &[[u32; 4]]) -> Vec<u32> {
+        let label = self.labels[cav.tets[0] as usize];
+        for &t in &cav.tets {
+            self.alive[t as usize] = false;
+            self.free.push(t);
+            for v in self.tets[t as usize] {
+                self.vtet[v as usize] = NO_NEIGHBOR;
+            }
+        }
+        let mut outside: FxHashMap<[u32; 3], (u32, u8)> = Default::default();
+        for (f, &o) in cav.shell.iter().zip(&cav.outer) {
+            let mut k = *f;
+            k.sort_unstable();
+            outside.insert(k, o);
+        }
+        let mut inner: FxHashMap<[u32; 3], (u32, u8)> = Default::default();
+        let mut ids = Vec::with_capacity(new.len());
+        for tv in new {
+            let t = match self.free.pop() {
+                Some(t) => {
+                    self.tets[t as usize] = *tv;
+                    self.nb[t as usize] = [NO_NEIGHBOR; 4];
+                    self.labels[t as usize] = label;
+                    self.alive[t as usize] = true;
+                    self.forced[t as usize] = 0;
+                    t
+                }
+                None => {
+                    self.tets.push(*tv);
+                    self.nb.push([NO_NEIGHBOR; 4]);
+                    self.labels.push(label);
+                    self.alive.push(true);
+                    self.forced.push(0);
+                    (self.tets.len() - 1) as u32
+                }
+            };
+            ids.push(t);
+        }
+        for &t in &ids {
+            let tv = self.tets[t as usize];
+            for &v in &tv {
+                self.vtet[v as usize] = t;
+            }
+            for (i, l) in TET_FACES.iter().enumerate() {
+                let mut k = [tv[l[0]], tv[l[1]], tv[l[2]]];
+                k.sort_unstable();
+                if let Some(&(n, j)) = outside.get(&k) {
+                    self.nb[t as usize][i] = n;
+                    if n != NO_NEIGHBOR {
+                        self.nb[n as usize][j as usize] = t;
+                    }
+                } else if let Some((u, j)) = inner.remove(&k) {
+                    self.nb[t as usize][i] = u;
+                    self.nb[u as usize][j as usize] = t;
+                } else {
+                    inner.insert(k, (t, i as u8));
+                }
+            }
+        }
+        debug_assert!(inner.is_empty());
+        // Shell corners keep a live tet outside the cavity when no new tet uses them.
+        for (f, &(n, _)) in cav.shell.iter().zip(&cav.outer) {
+            for &v in f {
+                if self.vtet[v as usize] == NO_NEIGHBOR && n != NO_NEIGHBOR {
+                    self.vtet[v as usize] = n;
+                }
+            }
+        }
+        ids
+    }
+}
+
+/// The smallest dihedral angle of a tet, degrees.
+pub(super) fn min_deg(c: &[P3; 4]) -> f64 {
+    dihedral_angles(c)
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min)
+        .to_degrees()
+}

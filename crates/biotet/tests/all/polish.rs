@@ -1,0 +1,113 @@
+//! Polish: the last pass over the unforced tets below 10° (moves and removals of interior
+//! points), on a synthetic sliver and on TetGen's brain mesh.
+
+use crate::common::{load_stl, octahedron, orient_all};
+use biotet::check::check;
+use biotet::geom::predicates::{Sign, orient3d};
+use biotet::polish::{PolishOptions, polish};
+use biotet::quality::forced::{classify, summarise};
+use biotet::quality::tet::dihedral_angles;
+use biotet::{TET_FACES, TetMesh};
+
+fn min_deg(m: &TetMesh, t: usize) -> f64 {
+    dihedral_angles(&m.corners(t))
+        .into_iter()
+        .fold(f64::INFINITY, f64::min)
+        .to_degrees()
+}
+
+fn assert_all_positive(m: &TetMesh) {
+    for t in 0..m.tets.len() {
+        let c = m.corners(t);
+        assert_eq!(orient3d(c[0], c[1], c[2], c[3]), Sign::Positive, "tet {t}");
+    }
+}
+
+/// The octahedron's eight faces coned to an interior point almost on one face: that face's tet
+/// is a sliver, and only the interior point can fix it.
+#[test]
+fn polish_moves_the_interior_point_of_a_sliver() {
+    let s = octahedron(1.0);
+    let mut points = s.points.clone();
+    // Near the centroid of face [0, 2, 4] (1/3, 1/3, 1/3), just inside.
+    points.push([0.32, 0.33, 0.33]);
+    let mut tets: Vec<[u32; 4]> = s.triangles.iter().map(|f| [f[0], f[1], f[2], 6]).collect();
+    orient_all(&points, &mut tets);
+    let mut m = TetMesh::new(points, tets, vec![1; 8]);
+    let before = (0..8).filter(|&t| min_deg(&m, t) < 10.0).count();
+    assert!(before >= 1, "the sliver is there");
+    let r = polish(&mut m, &PolishOptions::default());
+    assert_eq!(r.n_bad_before, before);
+    assert_eq!(r.n_bad_after, 0, "{r:?}");
+    assert!(r.moves_accepted >= 1);
+    assert_eq!(m.points.len(), 7, "no point added or removed");
+    assert_eq!(&m.points[..6], &s.points[..], "surface points stay");
+    assert_ne!(m.points[6], [0.32, 0.33, 0.33]);
+    assert_all_positive(&m);
+    let c = check(&m, Some(&s));
+    assert!(c.valid, "{c}");
+    assert!((0..m.tets.len()).all(|t| min_deg(&m, t) >= 10.0));
+}
+
+/// TetGen's brain mesh: polish lowers its unforced tets below 10°, keeps every surface point and
+/// triangle, the volume, and passes the checker.
+#[test]
+fn polish_improves_the_tetgen_brain_mesh() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/brain_tetgen.node"
+    );
+    let mut m = biotet_io::read_tet_mesh(std::path::Path::new(path))
+        .unwrap()
+        .mesh;
+    let surface = load_stl("brain_20k.stl");
+    let unforced_bad = |m: &TetMesh| {
+        let f = classify(m, &surface, 10.0);
+        summarise(m, &f, 10.0).n_unforced_dihedral_lt_10
+    };
+    let bad0 = unforced_bad(&m);
+    let mut on_boundary = vec![false; m.points.len()];
+    for (t, f) in m.boundary_faces() {
+        for k in TET_FACES[f] {
+            on_boundary[m.tets[t][k] as usize] = true;
+        }
+    }
+    let fixed: Vec<[f64; 3]> = (0..m.points.len())
+        .filter(|&i| on_boundary[i])
+        .map(|i| m.points[i])
+        .collect();
+    let volume = |m: &TetMesh| -> f64 {
+        (0..m.tets.len())
+            .map(|t| biotet::quality::tet::volume(&m.corners(t)))
+            .sum()
+    };
+    let v0 = volume(&m);
+    let mut again = m.clone();
+
+    let r = polish(&mut m, &PolishOptions::default());
+    polish(&mut again, &PolishOptions::default());
+    assert!(again == m, "deterministic");
+    // Its own count agrees with the quality report's.
+    assert_eq!(r.n_bad_before, bad0, "{r:?}");
+    let bad1 = unforced_bad(&m);
+    assert_eq!(r.n_bad_after, bad1, "{r:?}");
+    assert!(bad1 * 2 < bad0, "at least halved: {r:?}");
+    assert!(r.moves_accepted > 0 && r.removals_accepted > 0, "{r:?}");
+    assert_all_positive(&m);
+    // Only interior points move or go: the surface points keep their coordinates and order.
+    let mut still = vec![false; m.points.len()];
+    for (t, f) in m.boundary_faces() {
+        for k in TET_FACES[f] {
+            still[m.tets[t][k] as usize] = true;
+        }
+    }
+    let after: Vec<[f64; 3]> = (0..m.points.len())
+        .filter(|&i| still[i])
+        .map(|i| m.points[i])
+        .collect();
+    assert_eq!(after, fixed);
+    let c = check(&m, Some(&surface));
+    assert!(c.valid, "{c}");
+    let v1 = volume(&m);
+    assert!((v1 - v0).abs() < 1e-9 * v0, "volume {v1} vs {v0}");
+}
