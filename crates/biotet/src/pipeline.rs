@@ -33,7 +33,7 @@ pub struct PipelineOptions {
     /// exactly.
     pub smooth: Option<SmoothOptions>,
     /// Polish of the unforced tets still poor after smoothing (`None` skips it). Surface points
-    /// stay.
+    /// stay. It runs only after recovery, which makes the boundary faces exact.
     pub polish: Option<PolishOptions>,
 }
 
@@ -257,7 +257,7 @@ pub fn mesh_surface(
         report.smooth = Some(smooth(&mut mesh, Some(surface), o)?);
         stage(&mut report, "smooth", clock);
     }
-    if let Some(o) = &opts.polish {
+    if let Some(o) = opts.polish.as_ref().filter(|_| opts.recover.is_some()) {
         progress("polishing");
         let clock = Instant::now();
         report.polish = Some(polish(&mut mesh, o));

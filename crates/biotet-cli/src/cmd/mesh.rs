@@ -83,7 +83,7 @@ pub struct Args {
     /// Skip boundary recovery (LAST RESORT); missing input triangles are only counted.
     #[arg(long)]
     no_recover: bool,
-    /// Skip sliver removal.
+    /// Skip sliver removal (and the polish, its last pass).
     #[arg(long)]
     no_improve: bool,
     /// Skip smoothing.
@@ -207,7 +207,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
     if a.no_improve {
         opts.improve = None;
     }
-    if a.no_polish {
+    if a.no_polish || a.no_improve {
         opts.polish = None;
     }
     let (mesh, report) = mesh_surface(&surface, &sizing, &opts, &mut |s| stage.set(s))
