@@ -11,11 +11,12 @@
 //! 3. **the seed's cavity**: every tet sharing a corner with it, grown once by the next ring if
 //!    that fails past the search's root.
 //!
-//! **Parallel.** The cavities of moves 2 and 3 (most of the time) are searched in batches on all
-//! threads: a batch takes bad tets worst first while their cavities, grown ones included, share
-//! no tet and touch no tet of the batch across a face, so each fill stays valid whatever the
-//! others do; fills are applied in batch order. Batches are of a fixed size and do not depend on
-//! the number of threads, so neither does the result (tested).
+//! **Parallel.** Every search runs in batches on all threads. A bad tet enters a batch twice at
+//! most: first with its local moves (move 1), then, if they all failed, with its larger
+//! cavities (moves 2 and 3). A batch takes bad tets worst first while their cavities, grown ones
+//! included, share no tet and touch no tet of the batch across a face, so each fill stays valid
+//! whatever the others do; fills are applied in batch order. Batches are of a fixed size and do
+//! not depend on the number of threads, so neither does the result (tested).
 //!
 //! Cavities never cross a region: only tets with the bad tet's label are carved, so boundary
 //! and interface faces are always on the shell and stay exactly as they are. Points are never
@@ -217,14 +218,13 @@ struct Work<'a> {
     cache: Vec<[f64; 2]>,
     vtet: Vec<u32>,
     free: Vec<u32>,
-    searcher: Searcher,
+    /// Per tet: its local moves were tried and failed (it waits for its larger cavities).
+    local_tried: Vec<bool>,
     opts: ImproveOptions,
     report: ImproveReport,
     call_ms: Vec<f64>,
     call_nodes: Vec<u64>,
     queue: BinaryHeap<Entry>,
-    // Scratch.
-    mark: FxHashSet<u32>,
 }
 
 /// One carved cavity: its tets, the shell (faces pointing into it) with the tet outside each
@@ -287,9 +287,13 @@ fn search_cavity(
     }
 }
 
-/// The cavities of a [`Task`], smallest first.
+/// The moves of a [`Task`], in the order they are tried.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Kind {
+    /// The bad tet and a neighbour across a face (a 2-3 flip or better).
+    Flip,
+    /// The ring of tets around one of its edges (edge removal).
+    Ring,
     /// Every tet sharing an edge with the bad tet.
     Edges,
     /// The seed's cavity: every tet sharing a corner.
@@ -298,34 +302,128 @@ enum Kind {
     Grown,
 }
 
-/// The cavity refills of one bad tet in a batch, tried in order until one is accepted.
+/// The moves of one bad tet in a batch, tried in order until one is accepted: its local moves
+/// (`local`), or else its larger cavities.
 struct Task {
-    tries: Vec<(Kind, Cavity, Option<Plan>)>,
+    tet: u32,
+    local: bool,
+    tries: Vec<(Kind, Vec<u32>)>,
 }
 
-/// The searches of a [`Task`], run on any thread: one outcome per try, `None` for those not
-/// run. The grown cavity is skipped when the seed's cavity failed at its search's root (see
-/// [`step`]).
-fn run_task(
-    searcher: &mut Searcher,
-    pts: &[P3],
-    task: &Task,
-    metric: Metric,
-) -> Vec<Option<Outcome>> {
-    let mut out = Vec::with_capacity(task.tries.len());
-    let mut stop = false;
-    for (kind, cav, plan) in &task.tries {
-        let o = match plan {
-            Some(p) if !stop => {
-                let o = search_cavity(searcher, pts, cav, p, metric);
-                stop = o.accepted(p) || (*kind == Kind::Star && o.root_pruned());
-                Some(o)
+/// One move of a task as tried on a worker thread.
+struct Tried {
+    kind: Kind,
+    cav: Cavity,
+    /// `None`: the cavity is too large to search.
+    plan: Option<Plan>,
+    out: Option<Outcome>,
+}
+
+/// The mesh as the workers read it while a batch is searched (nothing changes meanwhile).
+struct View<'b> {
+    pts: &'b [P3],
+    tets: &'b [[u32; 4]],
+    nb: &'b [[u32; 4]],
+    opts: ImproveOptions,
+}
+
+impl View<'_> {
+    /// Build the cavity of `tets` (all of one label): shell faces turned inward, the tets across
+    /// them, and the inner corners.
+    fn cavity(&self, tets: Vec<u32>, mark: &mut FxHashSet<u32>) -> Cavity {
+        mark.clear();
+        mark.extend(tets.iter().copied());
+        let mut shell = Vec::new();
+        let mut outer = Vec::new();
+        let mut on_shell: FxHashSet<u32> = Default::default();
+        let mut all: Vec<u32> = Vec::new();
+        for &t in &tets {
+            let v = self.tets[t as usize];
+            all.extend_from_slice(&v);
+            for (i, l) in TET_FACES.iter().enumerate() {
+                let n = self.nb[t as usize][i];
+                if n != NO_NEIGHBOR && mark.contains(&n) {
+                    continue;
+                }
+                // Outward face reversed: the normal points into the cavity.
+                let f = [v[l[0]], v[l[2]], v[l[1]]];
+                on_shell.extend(f);
+                shell.push(f);
+                let j = if n == NO_NEIGHBOR {
+                    0
+                } else {
+                    self.nb[n as usize]
+                        .iter()
+                        .position(|&x| x == t)
+                        .unwrap_or(0) as u8
+                };
+                outer.push((n, j));
             }
-            _ => None,
-        };
-        out.push(o);
+        }
+        all.sort_unstable();
+        all.dedup();
+        let inner = all.into_iter().filter(|v| !on_shell.contains(v)).collect();
+        Cavity {
+            tets,
+            shell,
+            outer,
+            inner,
+        }
     }
-    out
+
+    /// The search options for refilling `cav` and its current worst tet; `None` when the cavity
+    /// is too large to search.
+    fn plan(&self, cav: &Cavity) -> Option<Plan> {
+        if cav.tets.len() > self.opts.max_cavity_tets {
+            return None;
+        }
+        let (mut old_worst, mut old_q) = (f64::INFINITY, f64::INFINITY);
+        for &t in &cav.tets {
+            let c = self.tets[t as usize].map(|v| self.pts[v as usize]);
+            old_worst = old_worst.min(measure(&c, self.opts.metric));
+            old_q = old_q.min(q_measure(&c));
+        }
+        // With the dihedral metric, candidates must also beat the cavity's worst angle (by more
+        // than rounding: the search's formula differs), so every fill found is accepted.
+        let so = SearchOptions {
+            min_quality: old_q.max(0.0),
+            min_dihedral: match self.opts.metric {
+                Metric::Q => 0.0,
+                Metric::Dihedral => old_worst.max(0.0) * (1.0 + 1e-9),
+            },
+            max_nodes: self.opts.max_nodes,
+            improve: Some(self.opts.improve_nodes),
+        };
+        Some(Plan { so, old_worst })
+    }
+
+    /// The moves of a [`Task`], run on any thread, until one is accepted. The grown cavity is
+    /// skipped when the seed's cavity failed at its search's root (see [`step`]).
+    fn run_task(&self, searcher: &mut Searcher, task: &Task) -> Vec<Tried> {
+        let mut mark = FxHashSet::default();
+        let mut done = Vec::with_capacity(task.tries.len());
+        for (kind, tets) in &task.tries {
+            let cav = self.cavity(tets.clone(), &mut mark);
+            let plan = self.plan(&cav);
+            let out = plan
+                .as_ref()
+                .map(|p| search_cavity(searcher, self.pts, &cav, p, self.opts.metric));
+            let stop = match (&out, &plan) {
+                (Some(o), Some(p)) => o.accepted(p) || (*kind == Kind::Star && o.root_pruned()),
+                _ => false,
+            };
+            done.push(Tried {
+                kind: *kind,
+                cav,
+                plan,
+                out,
+            });
+            if stop {
+                break;
+            }
+        }
+        done
+    }
 }
 
 impl<'a> Work<'a> {
@@ -370,75 +468,6 @@ impl<'a> Work<'a> {
         }
     }
 
-    /// Build the cavity of `tets` (all of one label): shell faces turned inward, the tets across
-    /// them, and the inner corners.
-    fn cavity(&mut self, tets: Vec<u32>) -> Cavity {
-        self.mark.clear();
-        self.mark.extend(tets.iter().copied());
-        let mut shell = Vec::new();
-        let mut outer = Vec::new();
-        let mut on_shell: FxHashSet<u32> = Default::default();
-        let mut all: Vec<u32> = Vec::new();
-        for &t in &tets {
-            let v = self.tets[t as usize];
-            all.extend_from_slice(&v);
-            for (i, l) in TET_FACES.iter().enumerate() {
-                let n = self.nb[t as usize][i];
-                if n != NO_NEIGHBOR && self.mark.contains(&n) {
-                    continue;
-                }
-                // Outward face reversed: the normal points into the cavity.
-                let f = [v[l[0]], v[l[2]], v[l[1]]];
-                on_shell.extend(f);
-                shell.push(f);
-                let j = if n == NO_NEIGHBOR {
-                    0
-                } else {
-                    self.nb[n as usize]
-                        .iter()
-                        .position(|&x| x == t)
-                        .unwrap_or(0) as u8
-                };
-                outer.push((n, j));
-            }
-        }
-        all.sort_unstable();
-        all.dedup();
-        let inner = all.into_iter().filter(|v| !on_shell.contains(v)).collect();
-        Cavity {
-            tets,
-            shell,
-            outer,
-            inner,
-        }
-    }
-
-    /// The search options for refilling `cav` and its current worst tet; `None` when the cavity
-    /// is too large to search.
-    fn plan(&mut self, cav: &Cavity) -> Option<Plan> {
-        if cav.tets.len() > self.opts.max_cavity_tets {
-            return None;
-        }
-        let (mut old_worst, mut old_q) = (f64::INFINITY, f64::INFINITY);
-        for &t in &cav.tets {
-            let [m, q] = self.measures(t);
-            old_worst = old_worst.min(m);
-            old_q = old_q.min(q);
-        }
-        // With the dihedral metric, candidates must also beat the cavity's worst angle (by more
-        // than rounding: the search's formula differs), so every fill found is accepted.
-        let so = SearchOptions {
-            min_quality: old_q.max(0.0),
-            min_dihedral: match self.opts.metric {
-                Metric::Q => 0.0,
-                Metric::Dihedral => old_worst.max(0.0) * (1.0 + 1e-9),
-            },
-            max_nodes: self.opts.max_nodes,
-            improve: Some(self.opts.improve_nodes),
-        };
-        Some(Plan { so, old_worst })
-    }
-
     /// Count a search's outcome in the report; true when its fill is to be accepted.
     fn record(
         &mut self,
@@ -469,24 +498,6 @@ impl<'a> Work<'a> {
                 false
             }
         }
-    }
-
-    /// Refill `cav` if a fill with a better worst tet exists; true when accepted.
-    fn try_cavity(
-        &mut self,
-        cav: &Cavity,
-        counts: fn(&mut ImproveReport) -> &mut MoveCounts,
-    ) -> bool {
-        let Some(plan) = self.plan(cav) else {
-            return false;
-        };
-        let pts = self.pts;
-        let out = search_cavity(&mut self.searcher, pts, cav, &plan, self.opts.metric);
-        let ok = self.record(&out, &plan, counts);
-        if ok && let Ok(fill) = &out.result {
-            self.replace(cav, &fill.tets);
-        }
-        ok
     }
 
     /// Is any of `tets` claimed by the pending batch?
@@ -541,6 +552,7 @@ impl<'a> Work<'a> {
             let t = match self.free.pop() {
                 Some(t) => {
                     self.forced[t as usize] = 0;
+                    self.local_tried[t as usize] = false;
                     self.cache[t as usize] = [f64::NAN; 2];
                     self.tets[t as usize] = *tv;
                     self.nb[t as usize] = [NO_NEIGHBOR; 4];
@@ -556,6 +568,7 @@ impl<'a> Work<'a> {
                     self.alive.push(true);
                     self.rounds.push(rounds);
                     self.forced.push(0);
+                    self.local_tried.push(false);
                     self.cache.push([f64::NAN; 2]);
                     (self.tets.len() - 1) as u32
                 }
@@ -729,48 +742,48 @@ const BATCH: usize = 128;
 
 /// What [`step`] made of one bad tet.
 enum Step {
-    /// Fixed by a local move, forced, or nothing to try.
+    /// Forced, or nothing to try.
     Done,
-    /// Its cavities, to search in the batch.
+    /// Its moves, to search in the batch.
     Task(Box<Task>),
     /// It touches the pending batch: it waits until the batch is done.
     Conflict,
 }
 
-/// One bad tet: local moves at once, then its larger cavities as a task: the tets sharing an
-/// edge with it, the seed's cavity and the grown one.
+/// One bad tet: its local moves as a task, first; if they failed, its larger cavities as a
+/// task: the tets sharing an edge with it, the seed's cavity and the grown one.
 fn step(w: &mut Work, tet: u32, scratch: &mut Vec<u32>) -> Step {
     let opts = w.opts;
     let label = w.labels[tet as usize];
-    if opts.local_moves {
-        // Face flips.
-        for i in 0..if opts.face_flips { 4 } else { 0 } {
-            let n = w.nb[tet as usize][i];
-            if n == NO_NEIGHBOR || w.labels[n as usize] != label || w.is_forced(n) {
-                continue;
-            }
-            if w.claimed(&[tet, n]) {
-                return Step::Conflict;
-            }
-            let cav = w.cavity(vec![tet, n]);
-            if w.try_cavity(&cav, |r| &mut r.face_flips) {
-                return Step::Done;
+    if opts.local_moves && !w.local_tried[tet as usize] {
+        let mut tries = Vec::new();
+        if opts.face_flips {
+            for i in 0..4 {
+                let n = w.nb[tet as usize][i];
+                if n != NO_NEIGHBOR && w.labels[n as usize] == label && !w.is_forced(n) {
+                    tries.push((Kind::Flip, vec![tet, n]));
+                }
             }
         }
-        // Edge removal.
         let tv = w.tets[tet as usize];
         for e in crate::mesh::tet::TET_EDGES {
-            let (a, b) = (tv[e[0]], tv[e[1]]);
-            let Some(ring) = w.ring(tet, a, b, label) else {
-                continue;
-            };
-            if w.claimed(&ring) {
+            if let Some(ring) = w.ring(tet, tv[e[0]], tv[e[1]], label) {
+                tries.push((Kind::Ring, ring));
+            }
+        }
+        if !tries.is_empty() {
+            let mut all: Vec<u32> = tries.iter().flat_map(|(_, t)| t.iter().copied()).collect();
+            all.sort_unstable();
+            all.dedup();
+            if w.claimed(&all) {
                 return Step::Conflict;
             }
-            let cav = w.cavity(ring);
-            if w.try_cavity(&cav, |r| &mut r.edge_removals) {
-                return Step::Done;
-            }
+            w.claim(&all);
+            return Step::Task(Box::new(Task {
+                tet,
+                local: true,
+                tries,
+            }));
         }
     }
     if w.is_forced(tet) {
@@ -820,47 +833,61 @@ fn step(w: &mut Work, tet: u32, scratch: &mut Vec<u32>) -> Step {
         return Step::Conflict;
     }
     w.claim(&grown);
-    let mut tries = Vec::with_capacity(3);
+    let mut tries: Vec<(Kind, Vec<u32>)> = Vec::with_capacity(3);
     for (kind, c) in [
         (Kind::Edges, edges),
         (Kind::Star, tets),
         (Kind::Grown, grown),
     ] {
-        let larger = tries
-            .last()
-            .is_none_or(|(_, p, _): &(Kind, Cavity, _)| c.len() > p.tets.len());
-        if larger {
-            let cav = w.cavity(c);
-            let plan = w.plan(&cav);
-            tries.push((kind, cav, plan));
+        if tries.last().is_none_or(|(_, p)| c.len() > p.len()) {
+            tries.push((kind, c));
         }
     }
-    Step::Task(Box::new(Task { tries }))
+    Step::Task(Box::new(Task {
+        tet,
+        local: false,
+        tries,
+    }))
 }
 
-/// Search the batch's tasks in parallel, then apply their fills in order.
+/// Search the batch's tasks in parallel, then apply their fills in order. A bad tet whose local
+/// moves all failed goes back to the queue for its larger cavities.
 fn run_batch(w: &mut Work, batch: &mut Vec<Task>) {
-    let (pts, metric) = (w.pts, w.opts.metric);
-    let outcomes: Vec<Vec<Option<Outcome>>> = batch
+    let view = View {
+        pts: w.pts,
+        tets: &w.tets,
+        nb: &w.nb,
+        opts: w.opts,
+    };
+    let results: Vec<Vec<Tried>> = batch
         .par_iter()
-        .map_init(Searcher::new, |s, task| run_task(s, pts, task, metric))
+        .map_init(Searcher::new, |s, task| view.run_task(s, task))
         .collect();
-    for (task, outs) in batch.drain(..).zip(outcomes) {
-        for ((kind, cav, plan), out) in task.tries.iter().zip(&outs) {
-            let (Some(out), Some(plan)) = (out, plan) else {
+    for (task, tried) in batch.drain(..).zip(results) {
+        let mut fixed = false;
+        for t in &tried {
+            let (Some(out), Some(plan)) = (&t.out, &t.plan) else {
                 continue;
             };
-            let counts: fn(&mut ImproveReport) -> &mut MoveCounts = match kind {
+            let counts: fn(&mut ImproveReport) -> &mut MoveCounts = match t.kind {
+                Kind::Flip => |r| &mut r.face_flips,
+                Kind::Ring => |r| &mut r.edge_removals,
                 Kind::Edges => |r| &mut r.edge_cavities,
                 Kind::Star => |r| &mut r.star_cavities,
                 Kind::Grown => |r| &mut r.grown_cavities,
             };
             if w.record(out, plan, counts) {
                 if let Ok(fill) = &out.result {
-                    w.replace(cav, &fill.tets);
+                    w.replace(&t.cav, &fill.tets);
                 }
+                fixed = true;
                 break;
             }
+        }
+        if task.local && !fixed {
+            w.local_tried[task.tet as usize] = true;
+            let v = w.value(task.tet);
+            w.queue_push(v, task.tet);
         }
     }
     w.batch_id += 1;
@@ -884,7 +911,7 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
         cache: Vec::new(),
         vtet: vec![NO_NEIGHBOR; mesh.points.len()],
         free: Vec::new(),
-        searcher: Searcher::new(),
+        local_tried: Vec::new(),
         opts: *opts,
         report: ImproveReport {
             metric: Some(opts.metric),
@@ -893,13 +920,13 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
         },
         call_ms: Vec::new(),
         call_nodes: Vec::new(),
-        mark: Default::default(),
         queue: BinaryHeap::new(),
     };
     let n = w.tets.len();
     w.alive = vec![true; n];
     w.rounds = vec![0; n];
     w.forced = vec![0; n];
+    w.local_tried = vec![false; n];
     for t in 0..n {
         for (i, f) in TET_FACES.iter().enumerate() {
             let nb = w.nb[t][i];
