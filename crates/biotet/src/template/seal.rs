@@ -9,6 +9,7 @@
 
 use crate::geom::vec3::{add, cross, dot, norm, scale, sub};
 use crate::mesh::surface::SurfaceMesh;
+use rayon::prelude::*;
 
 use super::voxels::{BUFFER, SURFACE_NODE, Template, UNPROCESSED, Zone};
 
@@ -30,10 +31,51 @@ pub fn mark_surface_nodes(t: &mut Template, surface: &SurfaceMesh, size: &[f64],
     }
 }
 
+/// Triangles per wave of [`seal_triangles`], and per parallel piece of a wave: bounded memory
+/// for the voxel lists, enough pieces to share.
+const WAVE: usize = 4096;
+const PIECE: usize = 128;
+
 /// Seal every triangle larger than its nodes' zones with a scaled prism; returns how many.
+///
+/// The prisms' voxels are found on all threads against the template as it is, then marked:
+/// sealing only turns unprocessed voxels into buffer, so the order does not matter and the
+/// result is the same on any number of threads.
 pub fn seal_triangles(t: &mut Template, surface: &SurfaceMesh, size: &[f64]) -> usize {
     let mut sealed = 0;
-    for tri in &surface.triangles {
+    for wave in surface.triangles.chunks(WAVE) {
+        let found: Vec<(usize, Vec<usize>)> = wave
+            .par_chunks(PIECE)
+            .map(|piece| {
+                let mut out = Vec::new();
+                let n = piece
+                    .iter()
+                    .filter(|tri| seal_one(t, surface, size, **tri, &mut out))
+                    .count();
+                (n, out)
+            })
+            .collect();
+        for (n, voxels) in found {
+            sealed += n;
+            for idx in voxels {
+                if t.state(idx) == UNPROCESSED {
+                    t.set_state(idx, BUFFER);
+                }
+            }
+        }
+    }
+    sealed
+}
+
+/// The voxels of one triangle's prism (appended to `out`); false when it needs none.
+fn seal_one(
+    t: &Template,
+    surface: &SurfaceMesh,
+    size: &[f64],
+    tri: [u32; 3],
+    out: &mut Vec<usize>,
+) -> bool {
+    {
         let v = tri.map(|i| i as usize);
         let p = v.map(|i| surface.points[i]);
         let d = v.map(|i| size[i]);
@@ -44,15 +86,14 @@ pub fn seal_triangles(t: &mut Template, surface: &SurfaceMesh, size: &[f64]) -> 
         ];
         let longest = edges.iter().copied().fold(0.0, f64::max);
         if longest <= d.iter().copied().fold(f64::INFINITY, f64::min) {
-            continue;
+            return false;
         }
         let nrm = cross(sub(p[1], p[0]), sub(p[2], p[0]));
         let len = norm(nrm);
         let per = edges[0] + edges[1] + edges[2];
         if len == 0.0 || per == 0.0 || !len.is_finite() {
-            continue; // degenerate: validation rejects these before deployment
+            return false; // degenerate: validation rejects these before deployment
         }
-        sealed += 1;
         let n = scale(nrm, 1.0 / len);
         // Incentre, and the corners pushed away from it by their sizes (eq. 2.7).
         let o = scale(
@@ -68,14 +109,14 @@ pub fn seal_triangles(t: &mut Template, surface: &SurfaceMesh, size: &[f64]) -> 
             add(o, scale(r, 1.0 + d[i] / l))
         });
         let h = d.map(|x| x * HEIGHT_FACTOR);
-        mark_prism(t, q, h, n);
+        prism_voxels(t, q, h, n, out);
+        true
     }
-    sealed
 }
 
-/// Mark unprocessed voxels strictly inside the prism over triangle `q` (mid-plane) with normal
-/// `n` and half-height `h[i]` at corner `i`, interpolated linearly.
-fn mark_prism(t: &mut Template, q: [[f64; 3]; 3], h: [f64; 3], n: [f64; 3]) {
+/// The unprocessed voxels strictly inside the prism over triangle `q` (mid-plane) with normal
+/// `n` and half-height `h[i]` at corner `i`, interpolated linearly (appended to `out`).
+fn prism_voxels(t: &Template, q: [[f64; 3]; 3], h: [f64; 3], n: [f64; 3], out: &mut Vec<usize>) {
     let hmax = h.iter().copied().fold(0.0, f64::max);
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
@@ -132,7 +173,7 @@ fn mark_prism(t: &mut Template, q: [[f64; 3]; 3], h: [f64; 3], n: [f64; 3]) {
                 }
                 let height = l0 * h[0] + l1 * h[1] + l2 * h[2];
                 if dist.abs() < height {
-                    t.set_state(idx, BUFFER);
+                    out.push(idx);
                 }
             }
         }
