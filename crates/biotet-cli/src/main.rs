@@ -7,6 +7,7 @@
 //! stages (all cores by default; no result depends on it).
 
 mod cmd;
+mod memory;
 mod plot;
 mod progress;
 
