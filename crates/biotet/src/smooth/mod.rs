@@ -353,17 +353,16 @@ pub fn smooth(
         }
     }
 
-    // Per-tet minimum solid angle, and the smallest edge.
-    // (Only the minima are kept: the clusters visited compute their own angles.)
-    let mut tet_min: Vec<f64> = (0..nt)
-        .into_par_iter()
-        .map(|t| min4(solid_angles(&mesh.corners(t))))
-        .collect();
+    // Per-tet minimum solid angle, and the smallest edge, in one pass over the corners. Only the
+    // minima are kept: the clusters visited compute their own angles.
+    let mut tet_min = vec![0.0; nt];
     // A minimum: the same float whatever the order of the reduction.
-    report.min_edge = (0..nt)
-        .into_par_iter()
-        .map(|t| {
+    report.min_edge = tet_min
+        .par_iter_mut()
+        .enumerate()
+        .map(|(t, m)| {
             let c = mesh.corners(t);
+            *m = min4(solid_angles(&c));
             TET_EDGES
                 .iter()
                 .map(|&[i, j]| norm(sub(c[i], c[j])))
