@@ -7,6 +7,7 @@
 //! stages (all cores by default; no result depends on it).
 
 mod cmd;
+mod memory;
 mod plot;
 mod progress;
 
@@ -69,6 +70,7 @@ pub const EXIT_INVALID: u8 = 1;
 pub const EXIT_ERROR: u8 = 2;
 
 fn main() -> ExitCode {
+    memory::map_large_blocks();
     // A closed stderr (`biotet mesh 2>&1 | head`) makes eprintln! panic: end quietly instead, as
     // for a closed stdout; any other panic keeps the default report.
     let default_hook = std::panic::take_hook();

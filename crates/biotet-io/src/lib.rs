@@ -55,6 +55,7 @@ pub mod tetgen;
 mod text;
 mod vtkxml;
 pub mod vtu;
+mod vtu_out;
 
 pub use error::{Error, Result};
 pub use grid::{read_scalar_grid, read_scalar_grid_named};

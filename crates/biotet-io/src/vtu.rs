@@ -28,14 +28,14 @@
 
 use std::io::{Read, Write};
 
-use biotet::quality::tet::TetMeasures;
+use biotet::quality::tet::{min_dihedral_deg, min_solid_sr, q_measure};
 use biotet::{SurfaceMesh, TetMesh};
 
-use crate::b64;
 use crate::common::{check_surface, check_tet, orient_tets, read_all};
 use crate::error::{Error, Result};
-use crate::text::{Out, show};
+use crate::text::show;
 use crate::vtkxml::{ArrayRef, Ctx, Values};
+use crate::vtu_out::{self, Array, Data, Ty};
 use crate::{MeshKind, SurfaceRead, TetRead};
 
 /// How [`write_tet_with`] encodes the data arrays.
@@ -54,132 +54,72 @@ pub enum VtuEncoding {
     Ascii,
 }
 
-/// Array values to write.
-enum Data {
-    F64(Vec<f64>),
-    I32(Vec<i32>),
-    I64(Vec<i64>),
-    U8(Vec<u8>),
-}
-
-impl Data {
-    fn ty(&self) -> &'static str {
-        match self {
-            Data::F64(_) => "Float64",
-            Data::I32(_) => "Int32",
-            Data::I64(_) => "Int64",
-            Data::U8(_) => "UInt8",
-        }
+/// The arrays of a tet mesh, made on demand: points, cells, `region` and the per-tet quality
+/// (computed a chunk at a time on all cores, never held whole).
+fn tet_arrays<'a>(mesh: &'a TetMesh, file: &str) -> Result<Vec<Array<'a>>> {
+    if let Some((t, &l)) = mesh
+        .labels
+        .iter()
+        .enumerate()
+        .find(|&(_, &l)| i32::try_from(l).is_err())
+    {
+        return Err(Error::invalid(
+            file,
+            format!("tet {t}: label {l} does not fit Int32"),
+        ));
     }
-
-    fn bytes(&self) -> Vec<u8> {
-        match self {
-            Data::F64(v) => v.iter().flat_map(|x| x.to_le_bytes()).collect(),
-            Data::I32(v) => v.iter().flat_map(|x| x.to_le_bytes()).collect(),
-            Data::I64(v) => v.iter().flat_map(|x| x.to_le_bytes()).collect(),
-            Data::U8(v) => v.clone(),
-        }
-    }
-}
-
-struct Array {
-    name: &'static str,
-    ncomp: usize,
-    data: Data,
-}
-
-/// Per-tet quality: (min dihedral degrees, min solid angle steradians, q), computed on all cores.
-fn quality(mesh: &TetMesh) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
-    let n = mesh.tets.len();
-    let mut dih = vec![0.0; n];
-    let mut sol = vec![0.0; n];
-    let mut q = vec![0.0; n];
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |t| t.get())
-        .min(16);
-    let chunk = n.div_ceil(threads).max(4096);
-    std::thread::scope(|s| {
-        for (k, ((d, so), qq)) in dih
-            .chunks_mut(chunk)
-            .zip(sol.chunks_mut(chunk))
-            .zip(q.chunks_mut(chunk))
-            .enumerate()
-        {
-            s.spawn(move || {
-                for i in 0..d.len() {
-                    let m = TetMeasures::of(&mesh.corners(k * chunk + i));
-                    d[i] = m.min_dihedral();
-                    so[i] = m.min_solid();
-                    qq[i] = m.q;
-                }
-            });
-        }
-    });
-    (dih, sol, q)
-}
-
-fn arrays(mesh: &TetMesh, file: &str) -> Result<(Vec<Array>, usize)> {
-    let nt = mesh.tets.len();
-    let wide_conn = mesh.points.len() > i32::MAX as usize;
-    let wide_off = 4 * nt > i32::MAX as usize;
-    let conn = if wide_conn {
-        Data::I64(mesh.tets.iter().flatten().map(|&v| v as i64).collect())
-    } else {
-        Data::I32(mesh.tets.iter().flatten().map(|&v| v as i32).collect())
+    let (np, nt) = (mesh.points.len(), mesh.tets.len());
+    let threads = vtu_out::threads();
+    let corners = move |t: usize| mesh.corners(t);
+    let measure = move |name, f: fn(&[[f64; 3]; 4]) -> f64| {
+        Array::new(name, 1, Ty::F64, nt, move |r| {
+            vtu_out::par_map(r, threads, &|t| f(&corners(t)))
+        })
     };
-    let offsets = if wide_off {
-        Data::I64((1..=nt as i64).map(|i| 4 * i).collect())
-    } else {
-        Data::I32((1..=nt as i32).map(|i| 4 * i).collect())
-    };
-    let mut region = Vec::with_capacity(nt);
-    for (t, &l) in mesh.labels.iter().enumerate() {
-        region.push(
-            i32::try_from(l).map_err(|_| {
-                Error::invalid(file, format!("tet {t}: label {l} does not fit Int32"))
-            })?,
-        );
-    }
-    let (dih, sol, q) = quality(mesh);
-    let a = |name, ncomp, data| Array { name, ncomp, data };
-    Ok((
-        vec![
-            a("Points", 3, Data::F64(mesh.points.as_flattened().to_vec())),
-            a("connectivity", 1, conn),
-            a("offsets", 1, offsets),
-            a("types", 1, Data::U8(vec![10; nt])),
-            a("region", 1, Data::I32(region)),
-            a("min_dihedral_deg", 1, Data::F64(dih)),
-            a("min_solid_angle_sr", 1, Data::F64(sol)),
-            a("q", 1, Data::F64(q)),
-        ],
-        4,
-    ))
+    Ok(vec![
+        Array::new("Points", 3, Ty::F64, np, |r| {
+            Data::F64(mesh.points[r].as_flattened().to_vec())
+        }),
+        cells_connectivity(&mesh.tets, np > i32::MAX as usize),
+        cells_offsets::<4>(nt, 4 * nt > i32::MAX as usize),
+        Array::new("types", 1, Ty::U8, nt, |r| Data::U8(vec![10; r.len()])),
+        Array::new("region", 1, Ty::I32, nt, |r| {
+            Data::I32(mesh.labels[r].iter().map(|&l| l as i32).collect())
+        }),
+        measure("min_dihedral_deg", min_dihedral_deg),
+        measure("min_solid_angle_sr", min_solid_sr),
+        measure("q", q_measure),
+    ])
 }
 
-const ZBLOCK: usize = 1 << 16;
+/// The `connectivity` array of cells with `K` corners (`Int64` if `wide`, else `Int32`).
+fn cells_connectivity<const K: usize>(cells: &[[u32; K]], wide: bool) -> Array<'_> {
+    if wide {
+        Array::new("connectivity", 1, Ty::I64, K * cells.len(), move |r| {
+            let c = &cells.as_flattened()[r];
+            Data::I64(c.iter().map(|&v| v as i64).collect())
+        })
+    } else {
+        Array::new("connectivity", 1, Ty::I32, K * cells.len(), move |r| {
+            let c = &cells.as_flattened()[r];
+            Data::I32(c.iter().map(|&v| v as i32).collect())
+        })
+    }
+}
 
-/// The header and payload of one binary array: uncompressed `[nbytes]` + data, or VTK's zlib
-/// layout `[nblocks, blocksize, lastsize, csize...]` + compressed blocks.
-fn block(bytes: &[u8], zlib: bool, file: &str) -> Result<(Vec<u8>, Vec<u8>)> {
-    if !zlib {
-        return Ok(((bytes.len() as u64).to_le_bytes().to_vec(), bytes.to_vec()));
+/// The `offsets` array of `n` cells of `K` corners each: `K, 2K, …` (`Int64` if `wide`, else
+/// `Int32`).
+fn cells_offsets<'a, const K: usize>(n: usize, wide: bool) -> Array<'a> {
+    let end = |r: std::ops::Range<usize>| (r.start as i64 + 1..=r.end as i64).map(|i| K as i64 * i);
+    if wide {
+        Array::new("offsets", 1, Ty::I64, n, move |r| {
+            Data::I64(end(r).collect())
+        })
+    } else {
+        Array::new("offsets", 1, Ty::I32, n, move |r| {
+            Data::I32(end(r).map(|x| x as i32).collect())
+        })
     }
-    let mut header = Vec::new();
-    let mut payload = Vec::new();
-    let nblocks = bytes.len().div_ceil(ZBLOCK);
-    let last = bytes.len() % ZBLOCK;
-    for x in [nblocks as u64, ZBLOCK as u64, last as u64] {
-        header.extend_from_slice(&x.to_le_bytes());
-    }
-    for c in bytes.chunks(ZBLOCK) {
-        let mut e = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::fast());
-        e.write_all(c).map_err(|e| Error::io(file, e))?;
-        let z = e.finish().map_err(|e| Error::io(file, e))?;
-        header.extend_from_slice(&(z.len() as u64).to_le_bytes());
-        payload.extend_from_slice(&z);
-    }
-    Ok((header, payload))
 }
 
 /// Write a tet mesh as VTU with appended raw binary data.
@@ -187,134 +127,25 @@ pub fn write_tet<W: Write>(w: W, mesh: &TetMesh, file: &str) -> Result<()> {
     write_tet_with(w, mesh, file, VtuEncoding::Raw)
 }
 
-/// Write a tet mesh as VTU with the chosen encoding.
+/// Write a tet mesh as VTU with the chosen encoding. Arrays are made and encoded a chunk at a
+/// time, so the writer needs little memory beside the mesh (compressed encodings also hold the
+/// compressed data).
 pub fn write_tet_with<W: Write>(w: W, mesh: &TetMesh, file: &str, enc: VtuEncoding) -> Result<()> {
-    check_tet(mesh, file)?;
-    let (arrays, first_cell_array) = arrays(mesh, file)?;
-    write_grid(
-        w,
-        (mesh.points.len(), mesh.tets.len()),
-        &arrays,
-        first_cell_array,
-        "region",
-        file,
-        enc,
-    )
+    write_tet_chunked(w, mesh, file, enc, vtu_out::CHUNK)
 }
 
-/// Write an unstructured grid of `sizes = (points, cells)` from its arrays: `Points`, the three
-/// cell arrays, then cell data from index `first_cell_array` on, `scalars` the active one.
-fn write_grid<W: Write>(
+/// [`write_tet_with`] with `chunk` tuples per chunk (small in tests, to cross chunk boundaries).
+fn write_tet_chunked<W: Write>(
     w: W,
-    sizes: (usize, usize),
-    arrays: &[Array],
-    first_cell_array: usize,
-    scalars: &str,
+    mesh: &TetMesh,
     file: &str,
     enc: VtuEncoding,
+    chunk: usize,
 ) -> Result<()> {
-    let zlib = matches!(enc, VtuEncoding::RawZlib | VtuEncoding::Base64Zlib);
-    let io = |e| Error::io(file, e);
-    let mut out = Out::new(w);
-    out.s("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\"");
-    if zlib {
-        out.s(" compressor=\"vtkZLibDataCompressor\"");
-    }
-    out.s(">\n  <UnstructuredGrid>\n    <Piece NumberOfPoints=\"");
-    out.int(sizes.0);
-    out.s("\" NumberOfCells=\"");
-    out.int(sizes.1);
-    out.s("\">\n");
-    // Appended blocks, computed up front for their offsets.
-    let appended = matches!(enc, VtuEncoding::Raw | VtuEncoding::RawZlib);
-    let mut blocks = Vec::new();
-    let mut offset = 0usize;
-    for (k, a) in arrays.iter().enumerate() {
-        match k {
-            0 => out.s("      <Points>\n"),
-            1 => out.s("      <Cells>\n"),
-            _ if k == first_cell_array => {
-                out.s("      <CellData Scalars=\"");
-                out.s(scalars);
-                out.s("\">\n");
-            }
-            _ => {}
-        }
-        out.s("        <DataArray type=\"");
-        out.s(a.data.ty());
-        out.s("\" Name=\"");
-        out.s(a.name);
-        out.s("\"");
-        if a.ncomp != 1 {
-            out.s(" NumberOfComponents=\"");
-            out.int(a.ncomp);
-            out.s("\"");
-        }
-        match enc {
-            VtuEncoding::Raw | VtuEncoding::RawZlib => {
-                let (h, p) = block(&a.data.bytes(), zlib, file)?;
-                out.s(" format=\"appended\" offset=\"");
-                out.int(offset);
-                out.s("\"/>\n");
-                offset += h.len() + p.len();
-                blocks.push((h, p));
-            }
-            VtuEncoding::Base64 | VtuEncoding::Base64Zlib => {
-                out.s(" format=\"binary\">\n");
-                let (h, p) = block(&a.data.bytes(), zlib, file)?;
-                if zlib {
-                    b64::encode(&h, &mut out.buf);
-                    b64::encode(&p, &mut out.buf);
-                } else {
-                    let mut all = h;
-                    all.extend_from_slice(&p);
-                    b64::encode(&all, &mut out.buf);
-                }
-                out.s("\n        </DataArray>\n");
-            }
-            VtuEncoding::Ascii => {
-                out.s(" format=\"ascii\">\n");
-                macro_rules! nums {
-                    ($v:expr, $f:ident) => {
-                        for (i, x) in $v.iter().enumerate() {
-                            out.$f(*x);
-                            out.c(if i % 12 == 11 { b'\n' } else { b' ' });
-                            out.check().map_err(io)?;
-                        }
-                    };
-                }
-                match &a.data {
-                    Data::F64(v) => nums!(v, f64),
-                    Data::I32(v) => nums!(v, int),
-                    Data::I64(v) => nums!(v, int),
-                    Data::U8(v) => nums!(v, int),
-                }
-                out.s("\n        </DataArray>\n");
-            }
-        }
-        out.check().map_err(io)?;
-        match k {
-            0 => out.s("      </Points>\n"),
-            3 => out.s("      </Cells>\n"),
-            _ => {}
-        }
-    }
-    out.s("      </CellData>\n    </Piece>\n  </UnstructuredGrid>\n");
-    if appended {
-        out.s("  <AppendedData encoding=\"raw\">\n   _");
-        for (h, p) in &blocks {
-            out.bytes(h);
-            out.check().map_err(io)?;
-            for c in p.chunks(1 << 16) {
-                out.bytes(c);
-                out.check().map_err(io)?;
-            }
-        }
-        out.s("\n  </AppendedData>\n");
-    }
-    out.s("</VTKFile>\n");
-    out.finish().map_err(io)?;
-    Ok(())
+    check_tet(mesh, file)?;
+    let arrays = tet_arrays(mesh, file)?;
+    let sizes = (mesh.points.len(), mesh.tets.len());
+    vtu_out::write_grid(w, sizes, &arrays, (4, "region"), file, enc, chunk)
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -762,41 +593,273 @@ pub fn write_surface<W: Write>(w: W, mesh: &SurfaceMesh, file: &str) -> Result<(
             format!("{} side-label pairs for {nt} triangles", mesh.sides.len()),
         ));
     }
-    let wide = mesh.points.len() > i32::MAX as usize || 3 * nt > i32::MAX as usize;
-    let (conn, offsets) = if wide {
-        (
-            Data::I64(mesh.triangles.iter().flatten().map(|&v| v as i64).collect()),
-            Data::I64((1..=nt as i64).map(|i| 3 * i).collect()),
-        )
-    } else {
-        (
-            Data::I32(mesh.triangles.iter().flatten().map(|&v| v as i32).collect()),
-            Data::I32((1..=nt as i32).map(|i| 3 * i).collect()),
-        )
-    };
-    let mut sides = Vec::with_capacity(2 * nt);
-    for (t, s) in mesh.sides.iter().enumerate() {
-        for &l in s {
-            sides.push(i32::try_from(l).map_err(|_| {
-                Error::invalid(file, format!("triangle {t}: label {l} does not fit Int32"))
-            })?);
-        }
+    if let Some((t, l)) = mesh.sides.iter().enumerate().find_map(|(t, s)| {
+        s.iter()
+            .find(|&&l| i32::try_from(l).is_err())
+            .map(|&l| (t, l))
+    }) {
+        return Err(Error::invalid(
+            file,
+            format!("triangle {t}: label {l} does not fit Int32"),
+        ));
     }
-    let a = |name, ncomp, data| Array { name, ncomp, data };
+    let np = mesh.points.len();
+    let wide = np > i32::MAX as usize || 3 * nt > i32::MAX as usize;
     let arrays = [
-        a("Points", 3, Data::F64(mesh.points.as_flattened().to_vec())),
-        a("connectivity", 1, conn),
-        a("offsets", 1, offsets),
-        a("types", 1, Data::U8(vec![5; nt])),
-        a("sides", 2, Data::I32(sides)),
+        Array::new("Points", 3, Ty::F64, np, |r| {
+            Data::F64(mesh.points[r].as_flattened().to_vec())
+        }),
+        cells_connectivity(&mesh.triangles, wide),
+        cells_offsets::<3>(nt, wide),
+        Array::new("types", 1, Ty::U8, nt, |r| Data::U8(vec![5; r.len()])),
+        Array::new("sides", 2, Ty::I32, nt, |r| {
+            Data::I32(
+                mesh.sides[r]
+                    .as_flattened()
+                    .iter()
+                    .map(|&l| l as i32)
+                    .collect(),
+            )
+        }),
     ];
-    write_grid(
+    vtu_out::write_grid(
         w,
-        (mesh.points.len(), nt),
+        (np, nt),
         &arrays,
-        4,
-        "sides",
+        (4, "sides"),
         file,
         VtuEncoding::Raw,
+        vtu_out::CHUNK,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use biotet::quality::tet::TetMeasures;
+
+    /// The tet arrays as whole little-endian byte arrays: (type, name, components, bytes).
+    type Whole = (&'static str, &'static str, usize, Vec<u8>);
+
+    fn le<T: Copy, const N: usize>(v: &[T], f: impl Fn(T) -> [u8; N]) -> Vec<u8> {
+        v.iter().flat_map(|&x| f(x)).collect()
+    }
+
+    /// The reference: every array built whole, quality from [`TetMeasures`] (how the writer
+    /// worked before it streamed).
+    fn whole_arrays(m: &TetMesh) -> Vec<Whole> {
+        let nt = m.tets.len();
+        let q: Vec<TetMeasures> = (0..nt).map(|t| TetMeasures::of(&m.corners(t))).collect();
+        let f64s =
+            |f: fn(&TetMeasures) -> f64| le(&q.iter().map(f).collect::<Vec<_>>(), f64::to_le_bytes);
+        let conn: Vec<i32> = m.tets.iter().flatten().map(|&v| v as i32).collect();
+        let offsets: Vec<i32> = (1..=nt as i32).map(|i| 4 * i).collect();
+        let region: Vec<i32> = m.labels.iter().map(|&l| l as i32).collect();
+        vec![
+            (
+                "Float64",
+                "Points",
+                3,
+                le(m.points.as_flattened(), f64::to_le_bytes),
+            ),
+            ("Int32", "connectivity", 1, le(&conn, i32::to_le_bytes)),
+            ("Int32", "offsets", 1, le(&offsets, i32::to_le_bytes)),
+            ("UInt8", "types", 1, vec![10; nt]),
+            ("Int32", "region", 1, le(&region, i32::to_le_bytes)),
+            (
+                "Float64",
+                "min_dihedral_deg",
+                1,
+                f64s(TetMeasures::min_dihedral),
+            ),
+            (
+                "Float64",
+                "min_solid_angle_sr",
+                1,
+                f64s(TetMeasures::min_solid),
+            ),
+            ("Float64", "q", 1, f64s(|m| m.q)),
+        ]
+    }
+
+    /// VTK's zlib layout of whole bytes, in one go.
+    fn zlib(bytes: &[u8]) -> (Vec<u8>, Vec<u8>) {
+        let mut h: Vec<u8> = [
+            bytes.len().div_ceil(1 << 16),
+            1 << 16,
+            bytes.len() % (1 << 16),
+        ]
+        .iter()
+        .flat_map(|&x| (x as u64).to_le_bytes())
+        .collect();
+        let mut p = Vec::new();
+        for c in bytes.chunks(1 << 16) {
+            let mut e = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::fast());
+            e.write_all(c).unwrap();
+            let z = e.finish().unwrap();
+            h.extend_from_slice(&(z.len() as u64).to_le_bytes());
+            p.extend_from_slice(&z);
+        }
+        (h, p)
+    }
+
+    /// The whole file from whole arrays, encoded in memory.
+    fn reference(m: &TetMesh, enc: VtuEncoding) -> Vec<u8> {
+        let zl = matches!(enc, VtuEncoding::RawZlib | VtuEncoding::Base64Zlib);
+        let mut s = String::from(
+            "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\"",
+        );
+        if zl {
+            s += " compressor=\"vtkZLibDataCompressor\"";
+        }
+        s += &format!(
+            ">\n  <UnstructuredGrid>\n    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">\n",
+            m.points.len(),
+            m.tets.len()
+        );
+        let mut out = Vec::new();
+        let mut appended = Vec::new();
+        for (k, (ty, name, ncomp, bytes)) in whole_arrays(m).into_iter().enumerate() {
+            s += [
+                "      <Points>\n",
+                "      <Cells>\n",
+                "",
+                "",
+                "      <CellData Scalars=\"region\">\n",
+            ]
+            .get(k)
+            .unwrap_or(&"");
+            s += &format!("        <DataArray type=\"{ty}\" Name=\"{name}\"");
+            if ncomp != 1 {
+                s += &format!(" NumberOfComponents=\"{ncomp}\"");
+            }
+            let (h, p) = if zl {
+                zlib(&bytes)
+            } else {
+                ((bytes.len() as u64).to_le_bytes().to_vec(), bytes.clone())
+            };
+            match enc {
+                VtuEncoding::Raw | VtuEncoding::RawZlib => {
+                    s += &format!(" format=\"appended\" offset=\"{}\"/>\n", appended.len());
+                    appended.extend_from_slice(&h);
+                    appended.extend_from_slice(&p);
+                }
+                VtuEncoding::Base64 | VtuEncoding::Base64Zlib => {
+                    s += " format=\"binary\">\n";
+                    let mut b = Vec::new();
+                    if zl {
+                        crate::b64::encode(&h, &mut b);
+                        crate::b64::encode(&p, &mut b);
+                    } else {
+                        crate::b64::encode(&[h, p].concat(), &mut b);
+                    }
+                    s += std::str::from_utf8(&b).unwrap();
+                    s += "\n        </DataArray>\n";
+                }
+                VtuEncoding::Ascii => {
+                    s += " format=\"ascii\">\n";
+                    let size = if ty == "UInt8" {
+                        1
+                    } else if ty == "Int32" {
+                        4
+                    } else {
+                        8
+                    };
+                    for (i, c) in bytes.chunks(size).enumerate() {
+                        let mut w = [0u8; 8];
+                        w[..size].copy_from_slice(c);
+                        s += &match ty {
+                            "Float64" => {
+                                ryu::Buffer::new().format(f64::from_le_bytes(w)).to_string()
+                            }
+                            "Int32" => i32::from_le_bytes(w[..4].try_into().unwrap()).to_string(),
+                            _ => c[0].to_string(),
+                        };
+                        s.push(if i % 12 == 11 { '\n' } else { ' ' });
+                    }
+                    s += "\n        </DataArray>\n";
+                }
+            }
+            s += ["      </Points>\n", "", "", "      </Cells>\n"]
+                .get(k)
+                .unwrap_or(&"");
+        }
+        s += "      </CellData>\n    </Piece>\n  </UnstructuredGrid>\n";
+        out.extend_from_slice(s.as_bytes());
+        if matches!(enc, VtuEncoding::Raw | VtuEncoding::RawZlib) {
+            out.extend_from_slice(b"  <AppendedData encoding=\"raw\">\n   _");
+            out.extend_from_slice(&appended);
+            out.extend_from_slice(b"\n  </AppendedData>\n");
+        }
+        out.extend_from_slice(b"</VTKFile>\n");
+        out
+    }
+
+    /// A labelled Delaunay mesh of pseudo-random points (large enough for several zlib blocks).
+    fn mesh(n: usize) -> TetMesh {
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        let mut r = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let pts = (0..n).map(|_| [r(), r(), r()]).collect();
+        let mut m = biotet::delaunay::Delaunay::from_points(pts)
+            .unwrap()
+            .to_tet_mesh();
+        m.labels = (0..m.tets.len() as u32).map(|t| 1 + t % 3).collect();
+        m
+    }
+
+    const ENCODINGS: [VtuEncoding; 5] = [
+        VtuEncoding::Raw,
+        VtuEncoding::RawZlib,
+        VtuEncoding::Base64,
+        VtuEncoding::Base64Zlib,
+        VtuEncoding::Ascii,
+    ];
+
+    #[test]
+    fn streaming_matches_the_whole_array_encoding() {
+        for n in [5, 40, 2500] {
+            let m = mesh(n);
+            for enc in ENCODINGS {
+                let want = reference(&m, enc);
+                // One chunk, chunks of awkward sizes (base64 carries, zlib blocks across chunks).
+                let one = if n < 100 { 1 } else { vtu_out::CHUNK };
+                for chunk in [vtu_out::CHUNK, one, 7, 1000] {
+                    let mut got = Vec::new();
+                    write_tet_chunked(&mut got, &m, "m.vtu", enc, chunk).unwrap();
+                    assert!(
+                        got == want,
+                        "{n} points, {enc:?}, chunks of {chunk}: differs"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn streamed_files_read_back() {
+        let m = mesh(300);
+        for enc in ENCODINGS {
+            let mut buf = Vec::new();
+            write_tet_chunked(&mut buf, &m, "m.vtu", enc, 13).unwrap();
+            let r = parse_tet(&buf, "m.vtu").unwrap();
+            assert_eq!(r.mesh.points, m.points, "{enc:?}");
+            assert_eq!(r.mesh.tets, m.tets, "{enc:?}");
+            assert_eq!(r.mesh.labels, m.labels, "{enc:?}");
+        }
+    }
+
+    #[test]
+    fn labels_beyond_int32_are_refused_before_writing() {
+        let mut m = mesh(20);
+        m.labels[3] = u32::MAX;
+        let mut buf = Vec::new();
+        let e = write_tet_with(&mut buf, &m, "m.vtu", VtuEncoding::Raw).unwrap_err();
+        assert!(e.to_string().contains("tet 3"), "{e}");
+        assert!(buf.is_empty());
+    }
 }

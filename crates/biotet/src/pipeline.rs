@@ -216,17 +216,20 @@ pub fn mesh_surface(
             rank[w] + (kept[w] & ((1u64 << b) - 1)).count_ones()
         }
     };
-    let neighbors: Vec<[u32; 4]> = del
-        .finite_tets()
-        .filter(|&t| kept[t as usize / 64] >> (t % 64) & 1 == 1)
-        .map(|t| del.adjacent(t).map(index_of))
-        .collect();
-    drop((kept, rank));
+    // Exact capacity: collecting the filter would double its way up, to 2× in the worst case.
+    let mut neighbors: Vec<[u32; 4]> = Vec::with_capacity(tets.len());
+    neighbors.extend(
+        del.finite_tets()
+            .filter(|&t| kept[t as usize / 64] >> (t % 64) & 1 == 1)
+            .map(|t| del.adjacent(t).map(index_of)),
+    );
+    drop((kept, rank, input_of, locator, scratch));
     let mut points = del.into_vertex_points();
     if points.len() != n_points {
         // Repeated input points share a vertex: give every input index its coordinates back.
         points = (0..n_points).map(|i| points[map[i] as usize]).collect();
     }
+    drop((map, dep.interior_regions));
     let mut mesh = compact(points, tets, neighbors, labels);
     stage(&mut report, "keep inside", clock);
 
@@ -318,12 +321,17 @@ fn compact(
             }
         }
     }
-    TetMesh {
+    let mut mesh = TetMesh {
         points: kept,
         tets,
         neighbors,
         labels,
-    }
+    };
+    // Recovery truncates the arrays in place: give the slack back for the later stages.
+    mesh.tets.shrink_to_fit();
+    mesh.neighbors.shrink_to_fit();
+    mesh.labels.shrink_to_fit();
+    mesh
 }
 
 /// Input triangles that are not a face of any tet (matched by point coordinates).

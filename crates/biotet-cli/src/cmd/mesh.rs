@@ -1,5 +1,6 @@
 //! `biotet mesh`: surface in, volume mesh out (the whole pipeline).
 
+use crate::memory::release_free_memory;
 use crate::{Common, plot, progress::Stage};
 use anyhow::{Context, Result, bail};
 use biotet::mesh::shells::Part;
@@ -210,9 +211,14 @@ pub fn run(a: Args) -> Result<ExitCode> {
     if a.no_polish || a.no_improve {
         opts.polish = None;
     }
-    let (mesh, report) = mesh_surface(&surface, &sizing, &opts, &mut |s| stage.set(s))
-        .with_context(|| name.clone())?;
+    // Each stage starts from what the previous ones left in use, not from their peaks.
+    let (mesh, report) = mesh_surface(&surface, &sizing, &opts, &mut |s| {
+        release_free_memory();
+        stage.set(s)
+    })
+    .with_context(|| name.clone())?;
 
+    release_free_memory();
     stage.set("measuring");
     let quality = QualityReport::of(&mesh);
     let forcing = {
@@ -222,6 +228,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
     // The peak of meshing alone, before the writer builds its arrays.
     let (peak_meshing_kb, _) = super::delaunay::memory_kb();
     if let Some(out) = &a.output {
+        release_free_memory();
         stage.set(format!("writing {}", out.display()));
         biotet_io::write_tet_mesh(out, &mesh)?;
     }

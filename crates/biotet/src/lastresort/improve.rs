@@ -38,7 +38,7 @@ use serde::Serialize;
 
 use super::search::{Fill, SearchError, SearchOptions, Searcher};
 use crate::mesh::tet::{NO_NEIGHBOR, TET_FACES, TetMesh};
-use crate::quality::tet::{dihedral_at, min_dihedral_deg, q_measure};
+use crate::quality::tet::{dihedral_at, min_dihedral_deg_by_chord, q_measure};
 use crate::quality::tri::min_angle_3d_deg;
 use rayon::prelude::*;
 
@@ -166,7 +166,7 @@ pub struct ImproveReport {
 fn measure(c: &[P3; 4], m: Metric) -> f64 {
     match m {
         Metric::Q => q_measure(c),
-        Metric::Dihedral => min_dihedral_deg(c),
+        Metric::Dihedral => min_dihedral_deg_by_chord(c),
     }
 }
 

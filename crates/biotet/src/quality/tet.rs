@@ -52,8 +52,9 @@ pub fn min_dihedral_chord2(c: &[[f64; 3]; 4]) -> f64 {
 }
 
 /// The smallest interior dihedral angle in degrees, from [`min_dihedral_chord2`]: one `asin`
-/// instead of six `atan2`, for code that ranks many tets (0 for a degenerate tet).
-pub fn min_dihedral_deg(c: &[[f64; 3]; 4]) -> f64 {
+/// instead of six `atan2`, for code that ranks many tets (0 for a degenerate tet). It may differ
+/// from [`min_dihedral_deg`] in the last bits.
+pub fn min_dihedral_deg_by_chord(c: &[[f64; 3]; 4]) -> f64 {
     let half_chord = 0.5 * min_dihedral_chord2(c).sqrt();
     2.0 * half_chord.min(1.0).asin().to_degrees()
 }
@@ -203,5 +204,70 @@ impl TetMeasures {
     /// Smallest solid angle (steradians).
     pub fn min_solid(&self) -> f64 {
         self.solid_sr.iter().copied().fold(f64::INFINITY, f64::min)
+    }
+}
+
+/// The smallest dihedral angle in degrees alone: bit for bit
+/// `TetMeasures::of(c).min_dihedral()`, without the other measures.
+pub fn min_dihedral_deg(c: &[[f64; 3]; 4]) -> f64 {
+    dihedral_angles(c)
+        .map(f64::to_degrees)
+        .into_iter()
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// The smallest solid angle in steradians alone: bit for bit `TetMeasures::of(c).min_solid()`.
+pub fn min_solid_sr(c: &[[f64; 3]; 4]) -> f64 {
+    solid_angles(c).into_iter().fold(f64::INFINITY, f64::min)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn single_measures_match_every_measure_bit_for_bit() {
+        // Regular, needle, sliver, flat and inverted tets, and pseudo-random ones.
+        let mut tets = vec![
+            [
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.5, 0.8, 0.0],
+                [0.5, 0.3, 0.8],
+            ],
+            [
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.5, 0.5, 1e-9],
+            ],
+            [
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [1.0, 1.0, 0.0],
+            ],
+            [
+                [0.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.2, 0.2, 0.7],
+            ],
+        ];
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let mut r = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64 * 10.0 - 5.0
+        };
+        for _ in 0..200 {
+            tets.push([0, 1, 2, 3].map(|_| [r(), r(), r()]));
+        }
+        for c in &tets {
+            let m = TetMeasures::of(c);
+            assert_eq!(min_dihedral_deg(c).to_bits(), m.min_dihedral().to_bits());
+            assert_eq!(min_solid_sr(c).to_bits(), m.min_solid().to_bits());
+        }
     }
 }

@@ -353,17 +353,16 @@ pub fn smooth(
         }
     }
 
-    // Per-tet minimum solid angle, and the smallest edge.
-    let mut tet_angles: Vec<[f64; 4]> = (0..nt)
-        .into_par_iter()
-        .map(|t| solid_angles(&mesh.corners(t)))
-        .collect();
-    let mut tet_min: Vec<f64> = tet_angles.iter().map(|a| min4(*a)).collect();
+    // Per-tet minimum solid angle, and the smallest edge, in one pass over the corners. Only the
+    // minima are kept: the clusters visited compute their own angles.
+    let mut tet_min = vec![0.0; nt];
     // A minimum: the same float whatever the order of the reduction.
-    report.min_edge = (0..nt)
-        .into_par_iter()
-        .map(|t| {
+    report.min_edge = tet_min
+        .par_iter_mut()
+        .enumerate()
+        .map(|(t, m)| {
             let c = mesh.corners(t);
+            *m = min4(solid_angles(&c));
             TET_EDGES
                 .iter()
                 .map(|&[i, j]| norm(sub(c[i], c[j])))
@@ -439,29 +438,28 @@ pub fn smooth(
             class.sort_unstable();
             let points = &mesh.points;
             let tets = &mesh.tets;
-            let angles = &tet_angles;
             let kinds = &kind;
-            let results: Vec<Option<(Moved, Vec<[f64; 4]>)>> = class
+            let results: Vec<Option<(Moved, Vec<f64>)>> = class
                 .par_iter()
                 .map_init(Cluster::default, |cluster, &v| {
                     let Kind::Motion(motion) = kinds[v as usize] else {
                         return None;
                     };
                     let s = &star[start[v as usize] as usize..start[v as usize + 1] as usize];
-                    cluster.load(points, tets, angles, s, v);
+                    cluster.load(points, tets, s, v);
                     let m = cluster.optimise(
                         points[v as usize],
                         motion,
                         slide_surface.as_ref(),
                         &params,
                     )?;
-                    Some((m, cluster.angles().to_vec()))
+                    Some((m, cluster.tet_minima().collect()))
                 })
                 .collect();
             for (&v, r) in class.iter().zip(results) {
                 let v = v as usize;
                 touched[v] = false;
-                let Some((m, new_angles)) = r else {
+                let Some((m, new_minima)) = r else {
                     continue;
                 };
                 debug_assert!(m.phi_after > m.phi_before);
@@ -470,11 +468,10 @@ pub fn smooth(
                 if let Some(l) = m.loc {
                     kind[v] = Kind::Motion(Motion::Slide(l));
                 }
-                // The cluster has the star's angles at the new position already.
+                // The cluster has the star's minima at the new position already.
                 let s = &star[start[v] as usize..start[v + 1] as usize];
-                for (&t, a) in s.iter().zip(new_angles) {
-                    tet_min[t as usize] = min4(a);
-                    tet_angles[t as usize] = a;
+                for (&t, a) in s.iter().zip(new_minima) {
+                    tet_min[t as usize] = a;
                     for &u in &mesh.tets[t as usize] {
                         touched[u as usize] = true;
                     }

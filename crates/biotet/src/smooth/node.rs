@@ -70,17 +70,11 @@ pub(crate) struct Moved {
 }
 
 impl Cluster {
-    /// Load the tets `star` around node `v` of a mesh with these points and tets, and
-    /// `angles[t]` the solid angles of tet `t` at those points (as
-    /// [`solid_angles`](crate::quality::tet::solid_angles) computes them).
-    pub fn load(
-        &mut self,
-        points: &[[f64; 3]],
-        tets: &[[u32; 4]],
-        angles: &[[f64; 4]],
-        star: &[u32],
-        v: u32,
-    ) {
+    /// Load the tets `star` around node `v` of a mesh with these points and tets, with their
+    /// solid angles (computed here, the same floats as
+    /// [`solid_angles`](crate::quality::tet::solid_angles): caching them for every tet of the
+    /// mesh would cost 32 bytes a tet for the few clusters visited).
+    pub fn load(&mut self, points: &[[f64; 3]], tets: &[[u32; 4]], star: &[u32], v: u32) {
         self.corners.clear();
         self.local.clear();
         self.angles.clear();
@@ -89,17 +83,13 @@ impl Cluster {
             let tv = tets[t as usize];
             let c = tv.map(|i| points[i as usize]);
             self.corners.push(c);
-            self.lengths.push(edge_lengths(&c));
+            let len = edge_lengths(&c);
+            let (det, den) = solid_angle_parts_with(&c, &len);
+            self.angles.push(den.map(|d| 2.0 * det.atan2(d)));
+            self.lengths.push(len);
             self.local
                 .push(tv.iter().position(|&i| i == v).unwrap_or(0));
-            self.angles.push(angles[t as usize]);
         }
-    }
-
-    /// The solid angles of each tet of the cluster at the free node's current position (after
-    /// [`Cluster::optimise`]: where it left the node), in the order of the loaded star.
-    pub fn angles(&self) -> &[[f64; 4]] {
-        &self.angles
     }
 
     /// The smallest solid angle of each tet of the cluster at the free node's current position
