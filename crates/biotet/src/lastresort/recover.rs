@@ -63,6 +63,7 @@ use crate::mesh::tet::{NO_NEIGHBOR, TET_FACES, TetMesh, sorted3};
 use crate::quality::tri::min_angle_3d_deg;
 use rustc_hash::{FxHashMap, FxHashSet};
 use serde::Serialize;
+use std::cell::Cell;
 use std::collections::VecDeque;
 use std::time::Instant;
 use thiserror::Error;
@@ -366,9 +367,17 @@ struct Recovery<'a> {
     tri_map: Vec<Option<[u32; 3]>>,
     alive: Vec<bool>,
     free: Vec<u32>,
-    vert_tets: Vec<Vec<u32>>,
-    /// Surface triangles at each mesh point.
-    surf_at: Vec<Vec<u32>>,
+    /// A live tet at each point (`NO_NEIGHBOR` for none): stars are walked from it across the
+    /// adjacency, instead of keeping a list per point (a third of recovery's memory).
+    vtet: Vec<u32>,
+    /// Stamps of the star walks, and the buffer of [`Self::with_star`].
+    star_mark: Vec<Cell<u32>>,
+    star_stamp: Cell<u32>,
+    star_buf: Cell<Vec<u32>>,
+    /// Surface triangles at each mesh point `x`: `surf_list[surf_start[x]..surf_start[x + 1]]`
+    /// (flat: most points are interior and have none).
+    surf_start: Vec<u32>,
+    surf_list: Vec<u32>,
     tet_mark: Vec<u32>,
     pt_mark: Vec<u32>,
     pt_local: Vec<u32>,
@@ -444,14 +453,26 @@ impl<'a> Recovery<'a> {
         opts: RecoverOptions,
     ) -> Recovery<'a> {
         let np = mesh.points.len();
-        let mut surf_at = vec![Vec::new(); np];
+        let mut surf_start = vec![0u32; np + 1];
+        for v in tri_map.iter().flatten() {
+            for &x in v {
+                surf_start[x as usize + 1] += 1;
+            }
+        }
+        for i in 0..np {
+            surf_start[i + 1] += surf_start[i];
+        }
+        let mut fill = surf_start.clone();
+        let mut surf_list = vec![0u32; surf_start[np] as usize];
         for (s, m) in tri_map.iter().enumerate() {
             if let Some(v) = m {
                 for &x in v {
-                    surf_at[x as usize].push(s as u32);
+                    surf_list[fill[x as usize] as usize] = s as u32;
+                    fill[x as usize] += 1;
                 }
             }
         }
+        drop(fill);
         let mut r = Recovery {
             mesh,
             surface,
@@ -459,8 +480,12 @@ impl<'a> Recovery<'a> {
             tri_map,
             alive: Vec::new(),
             free: Vec::new(),
-            vert_tets: Vec::new(),
-            surf_at,
+            vtet: Vec::new(),
+            star_mark: Vec::new(),
+            star_stamp: Cell::new(0),
+            star_buf: Cell::new(Vec::new()),
+            surf_start,
+            surf_list,
             tet_mark: Vec::new(),
             pt_mark: vec![0; np],
             pt_local: vec![0; np],
@@ -487,19 +512,66 @@ impl<'a> Recovery<'a> {
         self.alive = vec![true; self.mesh.tets.len()];
         self.free.clear();
         self.tet_mark = vec![0; self.mesh.tets.len()];
-        self.vert_tets = vec![Vec::new(); np];
+        self.vtet = vec![NO_NEIGHBOR; np];
         for (t, v) in self.mesh.tets.iter().enumerate() {
             for &x in v {
-                self.vert_tets[x as usize].push(t as u32);
+                self.vtet[x as usize] = t as u32;
+            }
+        }
+        self.star_mark = vec![Cell::new(0); self.mesh.tets.len()];
+        self.star_stamp.set(0);
+    }
+
+    /// The live tets with corner `v` (into `out`, in walk order).
+    fn star_into(&self, v: u32, out: &mut Vec<u32>) {
+        out.clear();
+        let t0 = self.vtet[v as usize];
+        if t0 == NO_NEIGHBOR {
+            return;
+        }
+        let st = self.star_stamp.get().wrapping_add(1);
+        self.star_stamp.set(st);
+        self.star_mark[t0 as usize].set(st);
+        out.push(t0);
+        let mut i = 0;
+        while i < out.len() {
+            let t = out[i] as usize;
+            i += 1;
+            let tv = self.mesh.tets[t];
+            for (&x, &n) in tv.iter().zip(&self.mesh.neighbors[t]) {
+                // The faces holding v are those opposite the other corners.
+                if x != v && n != NO_NEIGHBOR && self.star_mark[n as usize].get() != st {
+                    self.star_mark[n as usize].set(st);
+                    out.push(n);
+                }
             }
         }
     }
 
+    /// The live tets with corner `v`, sorted.
+    fn star(&self, v: u32) -> Vec<u32> {
+        let mut out = Vec::new();
+        self.star_into(v, &mut out);
+        out.sort_unstable();
+        out
+    }
+
+    /// `f` of the live tets with corner `v` (in walk order), without allocating.
+    fn with_star<R>(&self, v: u32, f: impl FnOnce(&[u32]) -> R) -> R {
+        let mut buf = self.star_buf.take();
+        self.star_into(v, &mut buf);
+        let r = f(&buf);
+        self.star_buf.set(buf);
+        r
+    }
+
     /// Is the triangle a face of a live tet?
     fn present(&self, v: [u32; 3]) -> bool {
-        self.vert_tets[v[0] as usize].iter().any(|&t| {
-            let tv = self.mesh.tets[t as usize];
-            tv.contains(&v[1]) && tv.contains(&v[2])
+        self.with_star(v[0], |star| {
+            star.iter().any(|&t| {
+                let tv = self.mesh.tets[t as usize];
+                tv.contains(&v[1]) && tv.contains(&v[2])
+            })
         })
     }
 
@@ -607,7 +679,7 @@ impl<'a> Recovery<'a> {
         let st = self.stamp;
         let mut tets = Vec::new();
         for &c in &v {
-            for &t in &self.vert_tets[c as usize] {
+            for t in self.star(c) {
                 if self.tet_mark[t as usize] != st {
                     self.tet_mark[t as usize] = st;
                     tets.push(t);
@@ -646,7 +718,7 @@ impl<'a> Recovery<'a> {
         let mut out = Vec::new();
         let mut stack: Vec<u32> = Vec::new();
         for &c in &v {
-            for &t in &self.vert_tets[c as usize] {
+            for t in self.star(c) {
                 if self.tet_mark[t as usize] != st {
                     self.tet_mark[t as usize] = st;
                     stack.push(t);
@@ -780,7 +852,8 @@ impl<'a> Recovery<'a> {
         let mut found_m = false;
         let mkey = sorted3(m);
         for &x in &cav.points {
-            for &s in &self.surf_at[x as usize] {
+            let (a, b) = (self.surf_start[x as usize], self.surf_start[x as usize + 1]);
+            for &s in &self.surf_list[a as usize..b as usize] {
                 if !seen.insert(s) {
                     continue;
                 }
@@ -842,17 +915,19 @@ impl<'a> Recovery<'a> {
 
     /// Is `v` a face between two tets of the cavity?
     fn interior_face(&self, v: [u32; 3], st: u32) -> bool {
-        let mut n = 0;
-        for &t in &self.vert_tets[v[0] as usize] {
-            let tv = self.mesh.tets[t as usize];
-            if tv.contains(&v[1]) && tv.contains(&v[2]) {
-                if self.tet_mark[t as usize] != st {
-                    return false;
+        self.with_star(v[0], |star| {
+            let mut n = 0;
+            for &t in star {
+                let tv = self.mesh.tets[t as usize];
+                if tv.contains(&v[1]) && tv.contains(&v[2]) {
+                    if self.tet_mark[t as usize] != st {
+                        return false;
+                    }
+                    n += 1;
                 }
-                n += 1;
             }
-        }
-        n == 2
+            n == 2
+        })
     }
 
     /// Does triangle `v` (corners in the cavity) lie inside the cavity? Exact: no improper
@@ -902,7 +977,7 @@ impl<'a> Recovery<'a> {
             };
         }
         let [u, vv, w] = tp;
-        for &t in &self.vert_tets[v[0] as usize] {
+        for t in self.star(v[0]) {
             if self.tet_mark[t as usize] != st {
                 continue;
             }
@@ -1011,12 +1086,6 @@ impl<'a> Recovery<'a> {
         }
         for &t in &cav.tets {
             self.alive[t as usize] = false;
-            for &x in &self.mesh.tets[t as usize] {
-                let l = &mut self.vert_tets[x as usize];
-                if let Some(p) = l.iter().position(|&y| y == t) {
-                    l.swap_remove(p);
-                }
-            }
             self.free.push(t);
         }
         let mut slots = Vec::with_capacity(new_tets.len());
@@ -1037,18 +1106,29 @@ impl<'a> Recovery<'a> {
                     self.mesh.neighbors.reserve_exact(extra);
                     self.alive.reserve_exact(extra);
                     self.tet_mark.reserve_exact(extra);
+                    self.star_mark.reserve_exact(extra);
                 }
                 self.mesh.tets.push(*t);
                 self.mesh.labels.push(label);
                 self.mesh.neighbors.push([NO_NEIGHBOR; 4]);
                 self.alive.push(true);
                 self.tet_mark.push(0);
+                self.star_mark.push(Cell::new(0));
                 (self.mesh.tets.len() - 1) as u32
             };
             for &x in t {
-                self.vert_tets[x as usize].push(slot);
+                self.vtet[x as usize] = slot;
             }
             slots.push(slot);
+        }
+        // A cavity point the fill left out has no tet now (its old one is dead or reused).
+        for &x in &cav.points {
+            let t = self.vtet[x as usize];
+            if t != NO_NEIGHBOR
+                && (!self.alive[t as usize] || !self.mesh.tets[t as usize].contains(&x))
+            {
+                self.vtet[x as usize] = NO_NEIGHBOR;
+            }
         }
         // Adjacency: among the new tets, then across the shell.
         let mut open: FxHashMap<[u32; 3], (u32, u8)> = FxHashMap::default();
@@ -1095,8 +1175,8 @@ impl<'a> Recovery<'a> {
         let id = self.mesh.points.len() as u32;
         // A cavity point now; removed again by `carve_and_fill` if the fill fails.
         self.mesh.points.push(p);
-        self.vert_tets.push(Vec::new());
-        self.surf_at.push(Vec::new());
+        self.vtet.push(NO_NEIGHBOR);
+        self.surf_start.push(self.surf_list.len() as u32);
         self.pt_mark.push(self.stamp);
         self.pt_local.push(cav.points.len() as u32);
         cav.points.push(id);
@@ -1137,12 +1217,12 @@ impl<'a> Recovery<'a> {
     fn drop_unused_points(&mut self, n0: usize) {
         while self.mesh.points.len() > n0 {
             let last = self.mesh.points.len() - 1;
-            if !self.vert_tets[last].is_empty() {
+            if self.vtet[last] != NO_NEIGHBOR {
                 break;
             }
             self.mesh.points.pop();
-            self.vert_tets.pop();
-            self.surf_at.pop();
+            self.vtet.pop();
+            self.surf_start.pop();
             self.pt_mark.pop();
             self.pt_local.pop();
         }

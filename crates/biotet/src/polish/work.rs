@@ -66,16 +66,19 @@ impl Work {
     }
 
     /// Put the (compacted) result back into `mesh`: dead tets and removed points dropped, point
-    /// order otherwise kept.
-    pub fn finish(self, mesh: &mut TetMesh) {
+    /// order otherwise kept. In place (a new index is never above the old one), so the mesh is
+    /// never held twice: this is the peak of the pipeline's memory otherwise.
+    pub fn finish(mut self, mesh: &mut TetMesh) {
         let mut new_pt = vec![u32::MAX; self.pts.len()];
-        let mut points = Vec::with_capacity(self.pts.len());
-        for (i, p) in self.pts.iter().enumerate() {
+        let mut k = 0usize;
+        for (i, slot) in new_pt.iter_mut().enumerate() {
             if self.vtet[i] != NO_NEIGHBOR {
-                new_pt[i] = points.len() as u32;
-                points.push(*p);
+                *slot = k as u32;
+                self.pts[k] = self.pts[i];
+                k += 1;
             }
         }
+        self.pts.truncate(k);
         let mut new_tet = vec![NO_NEIGHBOR; self.tets.len()];
         let mut k = 0u32;
         for (t, slot) in new_tet.iter_mut().enumerate() {
@@ -84,26 +87,31 @@ impl Work {
                 k += 1;
             }
         }
-        let (mut tets, mut nb, mut labels) = (Vec::new(), Vec::new(), Vec::new());
         for t in 0..self.tets.len() {
-            if !self.alive[t] {
+            let new = new_tet[t];
+            if new == NO_NEIGHBOR {
                 continue;
             }
-            tets.push(self.tets[t].map(|v| new_pt[v as usize]));
-            nb.push(self.nb[t].map(|n| {
+            let new = new as usize;
+            self.tets[new] = self.tets[t].map(|v| new_pt[v as usize]);
+            self.nb[new] = self.nb[t].map(|n| {
                 if n == NO_NEIGHBOR {
                     n
                 } else {
                     new_tet[n as usize]
                 }
-            }));
-            labels.push(self.labels[t]);
+            });
+            self.labels[new] = self.labels[t];
         }
+        let k = k as usize;
+        self.tets.truncate(k);
+        self.nb.truncate(k);
+        self.labels.truncate(k);
         *mesh = TetMesh {
-            points,
-            tets,
-            neighbors: nb,
-            labels,
+            points: self.pts,
+            tets: self.tets,
+            neighbors: self.nb,
+            labels: self.labels,
         };
     }
 
