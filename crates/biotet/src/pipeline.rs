@@ -8,8 +8,9 @@ use rustc_hash::{FxHashMap, FxHashSet};
 use serde::Serialize;
 
 use crate::delaunay::{Delaunay, DelaunayError};
+use crate::lastresort::recover::recover_built;
 use crate::lastresort::{
-    ImproveOptions, ImproveReport, RecoverError, RecoverOptions, RecoverReport, improve, recover,
+    ImproveOptions, ImproveReport, RecoverError, RecoverOptions, RecoverReport, improve,
 };
 use crate::mesh::coord_key;
 use crate::mesh::inside::{Location, RegionLocator, Transitions};
@@ -236,7 +237,7 @@ pub fn mesh_surface(
     if let Some(o) = &opts.recover {
         progress("recovering the boundary");
         let clock = Instant::now();
-        report.recover = Some(recover(&mut mesh, surface, o)?);
+        report.recover = Some(recover_built(&mut mesh, surface, o)?);
         // Recovery drops the outside tets; drop the points only they used.
         let TetMesh {
             points,
