@@ -4,6 +4,7 @@
 
 use std::time::Instant;
 
+use rayon::prelude::*;
 use rustc_hash::{FxHashMap, FxHashSet};
 use serde::Serialize;
 
@@ -177,32 +178,50 @@ pub fn mesh_surface(
     }
     let ns = dep.n_surface as u32;
     let locator = RegionLocator::new(surface);
-    let mut scratch = Transitions::default();
     // Which slots are kept, as a bitset with a rank per word: the kept tets' neighbours come
     // from the triangulation's own adjacency (no face sorting, no per-slot index array).
     let mut kept = vec![0u64; del.n_slots().div_ceil(64)];
     let mut tets = Vec::with_capacity(del.n_finite_tets());
     let mut labels = Vec::with_capacity(del.n_finite_tets());
-    for t in del.finite_tets() {
-        let w = del.tet(t);
-        let v = w.map(|x| input_of[x as usize]);
-        let on_surface = v.iter().filter(|&&x| x < ns).count();
-        let label = if on_surface >= 2 {
-            report.n_centroid_tests += 1;
-            centroid_region(del.tet_points(t), &locator, &mut scratch)
-        } else {
-            let i = v.iter().find(|&&x| x >= ns).copied().unwrap_or(0);
-            dep.interior_regions[(i - ns) as usize]
-        };
-        // With recovery to follow, every tet is kept: recovery works on the convex hull and
-        // labels by flood fill across the recovered surface; the centroid labels stay only
-        // where it cannot (triangles left unrecovered).
-        if label != 0 || opts.recover.is_some() {
-            kept[t as usize / 64] |= 1 << (t % 64);
-            tets.push(v);
-            labels.push(label);
+    // Tets with two or more surface corners need a centroid test: those are found on all
+    // threads, a chunk at a time (bounded scratch), and taken in order.
+    let mut all = del.finite_tets();
+    let mut chunk = Vec::with_capacity(CENTROID_CHUNK);
+    loop {
+        chunk.clear();
+        chunk.extend(all.by_ref().take(CENTROID_CHUNK));
+        if chunk.is_empty() {
+            break;
+        }
+        let found: Vec<([u32; 4], u32)> = chunk
+            .par_iter()
+            .map_init(Transitions::default, |scratch, &t| {
+                let v = del.tet(t).map(|x| input_of[x as usize]);
+                let on_surface = v.iter().filter(|&&x| x < ns).count();
+                let label = if on_surface >= 2 {
+                    centroid_region(del.tet_points(t), &locator, scratch)
+                } else {
+                    let i = v.iter().find(|&&x| x >= ns).copied().unwrap_or(0);
+                    dep.interior_regions[(i - ns) as usize]
+                };
+                (v, label)
+            })
+            .collect();
+        for (&t, (v, label)) in chunk.iter().zip(found) {
+            if v.iter().filter(|&&x| x < ns).count() >= 2 {
+                report.n_centroid_tests += 1;
+            }
+            // With recovery to follow, every tet is kept: recovery works on the convex hull and
+            // labels by flood fill across the recovered surface; the centroid labels stay only
+            // where it cannot (triangles left unrecovered).
+            if label != 0 || opts.recover.is_some() {
+                kept[t as usize / 64] |= 1 << (t % 64);
+                tets.push(v);
+                labels.push(label);
+            }
         }
     }
+    drop(all);
     let mut rank = Vec::with_capacity(kept.len());
     let mut r = 0u32;
     for w in &kept {
@@ -224,7 +243,7 @@ pub fn mesh_surface(
             .filter(|&t| kept[t as usize / 64] >> (t % 64) & 1 == 1)
             .map(|t| del.adjacent(t).map(index_of)),
     );
-    drop((kept, rank, input_of, locator, scratch));
+    drop((kept, rank, input_of, locator));
     let mut points = del.into_vertex_points();
     if points.len() != n_points {
         // Repeated input points share a vertex: give every input index its coordinates back.
@@ -274,6 +293,9 @@ pub fn mesh_surface(
     report.seconds_total = start.elapsed().as_secs_f64();
     Ok((mesh, report))
 }
+
+/// Tets per parallel chunk of the inside test.
+const CENTROID_CHUNK: usize = 1 << 16;
 
 /// Region of a tet by its centroid; if the centroid lies exactly on the surface, other interior
 /// points of the tet decide.
