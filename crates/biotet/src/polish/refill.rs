@@ -26,7 +26,7 @@ pub(super) struct RefillParams {
 }
 
 /// The unforced worst angle, overall worst angle and count below `thr` of `tets`.
-fn judge(w: &mut Work, tets: &[u32], thr: f64) -> (f64, f64, usize) {
+pub(super) fn judge(w: &mut Work, tets: &[u32], thr: f64) -> (f64, f64, usize) {
     let (mut unforced, mut all, mut below) = (f64::INFINITY, f64::INFINITY, 0);
     for &t in tets {
         let a = w.min_angle(t);
@@ -42,7 +42,12 @@ fn judge(w: &mut Work, tets: &[u32], thr: f64) -> (f64, f64, usize) {
 /// The search's root test, cheaply: every shell face has a point making a tet with it whose
 /// smallest dihedral angle is above `floor` degrees. Such a tet is far from flat, so its
 /// orientation in floating point is certain; without one no fill exists.
-fn every_face_has_candidate(pts: &[P3], shell: &[[u32; 3]], cands: &[u32], floor: f64) -> bool {
+pub(super) fn every_face_has_candidate(
+    pts: &[P3],
+    shell: &[[u32; 3]],
+    cands: &[u32],
+    floor: f64,
+) -> bool {
     let s = (floor.to_radians() / 2.0).sin();
     let lim = 4.0 * s * s;
     shell.iter().all(|f| {
@@ -126,7 +131,7 @@ impl Work {
             return Some(ids);
         }
         let back = self.cavity(ids);
-        self.replace(&back, &old_tets);
+        self.replace_in(&back, &old_tets, Some(&cav.tets));
         None
     }
 }
