@@ -1,17 +1,23 @@
 //! Steiner points: fix an unforced tet below the threshold with one new interior point.
 //!
-//! The cavity is the tet and its face neighbours of the same label, or, when that fails, every
-//! tet of its label sharing an edge with it (a cavity with an interior point is not tried).
-//! Boundary and interface faces are never crossed, so they stay on the cavity's shell. The new
-//! point is the candidate (the tet's centroid and circumcentre, the centroids of the cavity's
-//! tets, the midpoints between the tet's centroid and theirs, the shell's vertex centroid) whose
-//! cone over the shell has the best smallest dihedral angle among those every shell face sees
-//! strictly on its inner side (exact `orient3d`): the shell is then star-shaped from it and the
-//! cone fills the cavity exactly. The point is moved to raise its star's worst unforced angle
-//! ([`Work::relocate`]), the cavity is refilled by the LAST RESORT search with the point as an
-//! inner point every fill uses ([`Work::refill`]), and the result is kept only if the cavity's
-//! worst unforced angle rises, its worst angle does not fall and no more of its tets are below
-//! the threshold; otherwise the old tets come back and the point is dropped.
+//! The cavity is the tet and its unforced face neighbours of the same label, or, when that fails,
+//! every unforced tet of its label sharing an edge with it (a cavity with an interior point is not
+//! tried). Boundary and interface faces are never crossed, so they stay on the cavity's shell.
+//! The candidates are the tet's centroid and circumcentre, the centroids of the cavity's tets, the
+//! midpoints between the tet's centroid and theirs, the shell's vertex centroid, and points pushed
+//! into the shell's kernel from the two centroids (cyclic projection, floating point).
+//! - If some candidate is seen strictly on the inner side of every shell face (exact `orient3d`),
+//!   the shell is star-shaped from it and its cone fills the cavity exactly: the candidate with
+//!   the best cone is added, the cavity coned to it, and the point moved to raise its star's worst
+//!   unforced angle ([`Work::relocate`]).
+//! - Otherwise the candidate strictly inside a cavity tet (exact) that makes a tet above the
+//!   threshold with the most shell faces is added, and only the search can fill the cavity.
+//!
+//! Unless every tet is then above the threshold, the LAST RESORT search refills the cavity with
+//! the point as an inner point every fill uses: first every tet above the threshold, then (face
+//! cavities only) every tet above the cavity's worst before. The result is kept only if the
+//! cavity's worst unforced angle rises, its worst angle does not fall and no more of its tets are
+//! below the threshold; otherwise the old tets come back under their ids and the point is dropped.
 
 use rustc_hash::FxHashSet;
 
@@ -21,7 +27,7 @@ use crate::lastresort::{SearchOptions, Searcher};
 use crate::mesh::tet::NO_NEIGHBOR;
 use crate::quality::tet::min_dihedral_chord2;
 
-use super::refill::{RefillParams, every_face_has_candidate, judge};
+use super::refill::{RefillParams, every_face_has_candidate, faces_without_candidate, judge};
 use super::relocate::StepParams;
 use super::work::{P3, Work};
 
@@ -86,6 +92,10 @@ impl Work {
         if tets.len() > rp.max_tets {
             return None;
         }
+        // Past the face cavity (at most five tets), only fills with every tet above the
+        // threshold are searched: the lower floor's fills there cost twice as much per
+        // insertion kept.
+        let large = tets.len() > 5;
         let cav = self.cavity(tets);
         let on_shell: FxHashSet<u32> = cav.shell.iter().flatten().copied().collect();
         if cav
@@ -95,24 +105,41 @@ impl Work {
         {
             return None;
         }
-        let x = self.best_point(t, &cav.tets, &cav.shell)?;
+        let (x, cone_ok) = self.best_point(t, &cav.tets, &cav.shell, thr)?;
         let old = judge(self, &cav.tets, thr);
         let old_tets: Vec<[u32; 4]> = cav.tets.iter().map(|&s| self.tets[s as usize]).collect();
         let p = self.pts.len() as u32;
         self.pts.push(x);
         self.vtet.push(NO_NEIGHBOR);
         self.fixed.push(false);
-        let cone: Vec<[u32; 4]> = cav.shell.iter().map(|f| [f[0], f[1], f[2], p]).collect();
-        let mut ids = self.replace(&cav, &cone);
-        self.relocate(p, thr.to_radians(), sp, star);
-        let mut new = judge(self, &ids, thr);
+        // With a star-shaped shell, the cone, the point moved; otherwise the old tets, and only a
+        // fill the search finds replaces them.
+        let (mut ids, mut new) = if cone_ok {
+            let cone: Vec<[u32; 4]> = cav.shell.iter().map(|f| [f[0], f[1], f[2], p]).collect();
+            let ids = self.replace(&cav, &cone);
+            self.relocate(p, thr.to_radians(), sp, star);
+            let new = judge(self, &ids, thr);
+            (ids, new)
+        } else {
+            (
+                cav.tets.clone(),
+                (f64::NEG_INFINITY, f64::NEG_INFINITY, usize::MAX),
+            )
+        };
+        let mut filled = cone_ok;
         if new.2 > 0 {
             // The search, with the point as the one inner point: first every tet above the
             // threshold, then every tet above the cavity's worst before (any other fill would be
             // rejected).
             let mut cands: Vec<u32> = on_shell.iter().copied().chain([p]).collect();
             cands.sort_unstable();
+            // A tet covers at most four shell faces, so a fill has at least a quarter of the faces
+            // with no tet above the threshold below it: more than before, and no fill can pass.
+            let poor = faces_without_candidate(&self.pts, &cav.shell, &cands, thr);
             for floor in [thr, old.1.max(0.0) * (1.0 + 1e-9)] {
+                if floor < thr && (large || poor.div_ceil(4) > old.2) {
+                    break;
+                }
                 if !every_face_has_candidate(&self.pts, &cav.shell, &cands, floor) {
                     continue;
                 }
@@ -127,6 +154,7 @@ impl Work {
                     let cur = self.cavity(ids);
                     ids = self.replace(&cur, &f.tets);
                     new = judge(self, &ids, thr);
+                    filled = true;
                     break;
                 }
             }
@@ -134,8 +162,10 @@ impl Work {
         if new.0 > old.0 && new.1 >= old.1 && new.2 <= old.2 {
             return Some(ids);
         }
-        let back = self.cavity(ids);
-        self.replace_in(&back, &old_tets, Some(&cav.tets));
+        if filled {
+            let back = self.cavity(ids);
+            self.replace_in(&back, &old_tets, Some(&cav.tets));
+        }
         debug_assert_eq!(self.vtet[p as usize], NO_NEIGHBOR);
         self.pts.pop();
         self.vtet.pop();
@@ -144,8 +174,10 @@ impl Work {
     }
 
     /// The candidate point whose cone over `shell` has the largest smallest dihedral angle among
-    /// those strictly inside every shell face's half-space (exact).
-    fn best_point(&self, t: u32, tets: &[u32], shell: &[[u32; 3]]) -> Option<P3> {
+    /// those strictly inside every shell face's half-space (exact), with `true`; when there is
+    /// none, the candidate strictly inside a tet of `tets` (exact) that makes a tet above `thr`
+    /// degrees with the most shell faces, with `false`.
+    fn best_point(&self, t: u32, tets: &[u32], shell: &[[u32; 3]], thr: f64) -> Option<(P3, bool)> {
         let c = self.corners(t);
         let ct = centroid(&c);
         let mut cands = vec![ct];
@@ -201,12 +233,16 @@ impl Work {
             if !x.iter().all(|&k| in_exact_range(k)) {
                 continue;
             }
-            let mut worst = f64::INFINITY;
+            // Every face sees it (floating point first), then the cone's worst tet.
             for f in shell {
                 let q = [f[0], f[1], f[2]].map(|v| self.pts[v as usize]);
                 if volume6(q[0], q[1], q[2], *x) <= 0.0 {
                     continue 'c;
                 }
+            }
+            let mut worst = f64::INFINITY;
+            for f in shell {
+                let q = [f[0], f[1], f[2]].map(|v| self.pts[v as usize]);
                 worst = worst.min(min_dihedral_chord2(&[q[0], q[1], q[2], *x]));
             }
             if worst.is_finite() {
@@ -214,12 +250,57 @@ impl Work {
             }
         }
         scored.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
-        scored.into_iter().map(|(_, i)| cands[i]).find(|x| {
+        let star = scored.into_iter().map(|(_, i)| cands[i]).find(|x| {
             shell.iter().all(|f| {
                 let q = [f[0], f[1], f[2]].map(|v| self.pts[v as usize]);
                 orient3d(q[0], q[1], q[2], *x) == Sign::Positive
             })
-        })
+        });
+        if let Some(x) = star {
+            return Some((x, true));
+        }
+        let s = (thr.to_radians() / 2.0).sin();
+        let lim = 4.0 * s * s;
+        let mut best: Option<(usize, P3)> = None;
+        for x in cands {
+            if !x.iter().all(|&k| in_exact_range(k)) {
+                continue;
+            }
+            let inside = tets.iter().any(|&s| {
+                let c = self.corners(s);
+                let sees = |k: usize| {
+                    let mut d = c;
+                    d[k] = x;
+                    d
+                };
+                (0..4).all(|k| {
+                    let d = sees(k);
+                    volume6(d[0], d[1], d[2], d[3]) > 0.0
+                }) && (0..4).all(|k| {
+                    let d = sees(k);
+                    orient3d(d[0], d[1], d[2], d[3]) == Sign::Positive
+                })
+            });
+            if !inside {
+                continue;
+            }
+            let floor = best.map_or(0, |b| b.0);
+            let mut served = 0;
+            for (i, f) in shell.iter().enumerate() {
+                if served + (shell.len() - i) <= floor {
+                    break;
+                }
+                let q = [f[0], f[1], f[2]].map(|v| self.pts[v as usize]);
+                let c = [q[0], q[1], q[2], x];
+                if volume6(c[0], c[1], c[2], c[3]) > 0.0 && min_dihedral_chord2(&c) > lim {
+                    served += 1;
+                }
+            }
+            if best.is_none() || served > floor {
+                best = Some((served, x));
+            }
+        }
+        best.map(|b| (b.1, false))
     }
 }
 
