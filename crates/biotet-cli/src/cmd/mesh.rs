@@ -90,10 +90,13 @@ pub struct Args {
     /// Skip smoothing.
     #[arg(long)]
     no_smooth: bool,
-    /// Skip polishing (the last pass that moves or removes interior points around the unforced
-    /// tets still below 10°).
+    /// Skip polishing (the last pass that moves, removes or adds interior points around the
+    /// unforced tets still below 10°).
     #[arg(long)]
     no_polish: bool,
+    /// Polish without Steiner points (no interior point is added to fix a tet below 10°).
+    #[arg(long)]
+    no_steiner: bool,
     /// 2D only: triangulate the PSLG's own points (isolated points included) without deploying
     /// template nodes.
     #[arg(long)]
@@ -207,6 +210,11 @@ pub fn run(a: Args) -> Result<ExitCode> {
     }
     if a.no_improve {
         opts.improve = None;
+    }
+    if a.no_steiner
+        && let Some(p) = opts.polish.as_mut()
+    {
+        p.insert = false;
     }
     if a.no_polish || a.no_improve {
         opts.polish = None;

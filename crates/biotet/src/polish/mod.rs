@@ -6,12 +6,20 @@
 //! tet, worst first, and for each of its interior corners:
 //! 1. **move** the corner to raise the smallest dihedral angle of the unforced tets around it
 //!    (`relocate`);
+//! 2. **remove** it, its star refilled without it with every tet above the threshold (`refill`);
 //!
-//! Surface points (on a boundary or interface face) never move and are never removed; every
-//! accepted change keeps every tet strictly positive (exact `orient3d`) and never lowers a forced
-//! tet below its angle before or the threshold. Sequential and in a fixed order, so the result is
-//! the same for any number of threads.
+//! then **refill** the tet and its face neighbours with the moved points (`refill`). After
+//! these rounds, each tet still bad gets one try at a Steiner point: **insert** a new interior
+//! point strictly inside a small cavity around it (`insert`), followed by one more round of moves
+//! around the tets still bad (the new points move too).
+//!
+//! Surface points (on a boundary or interface face) never move and are never removed, and no
+//! point is added on a boundary or interface face; every accepted change keeps every tet strictly
+//! positive (exact `orient3d`) and never lowers a forced tet below its angle before or the
+//! threshold. Sequential and in a fixed order, so the result is the same for any number of
+//! threads.
 
+mod insert;
 mod refill;
 mod relocate;
 mod work;
@@ -45,6 +53,9 @@ pub struct PolishOptions {
     pub remove: bool,
     /// Try refilling the tet and its face neighbours (after the moves).
     pub refill: bool,
+    /// Try one interior Steiner point per tet still bad after the rounds (see the `insert`
+    /// module), then one more round of moves.
+    pub insert: bool,
 }
 
 impl Default for PolishOptions {
@@ -56,6 +67,7 @@ impl Default for PolishOptions {
             move_iterations: 8,
             remove: true,
             refill: true,
+            insert: true,
         }
     }
 }
@@ -79,6 +91,12 @@ pub struct PolishReport {
     pub refills_tried: usize,
     /// Those accepted.
     pub refills_accepted: usize,
+    /// Steiner point insertions tried.
+    pub inserts_tried: usize,
+    /// Those accepted.
+    pub inserts_accepted: usize,
+    /// Points added (inserted and still there at the end).
+    pub points_added: usize,
     /// Unforced tets below the threshold before, by interior corners (see
     /// [`PolishReport::bad_by_interior_corners`]).
     pub bad_before_by_interior_corners: [usize; 5],
@@ -87,8 +105,9 @@ pub struct PolishReport {
     pub bad_by_interior_corners: [usize; 5],
     /// Smallest dihedral angle of an unforced tet after, degrees.
     pub min_unforced_deg: Option<f64>,
-    /// Milliseconds spent: `[scan, moves, removals, refills]`.
-    pub ms: [f64; 4],
+    /// Milliseconds spent: `[scan, moves, removals, refills, inserts]` (the last with the
+    /// round of moves after them).
+    pub ms: [f64; 5],
     /// Wall seconds.
     pub seconds: f64,
 }
@@ -107,6 +126,7 @@ pub fn polish(mesh: &mut TetMesh, opts: &PolishOptions) -> PolishReport {
         tie: 0.5f64.to_radians(),
     };
     let n = w.tets.len() as u32;
+    let np0 = w.pts.len();
     let mut bad = scan(&mut w, 0..n, thr);
     report.ms[0] = clock.elapsed().as_secs_f64() * 1e3;
     report.n_bad_before = bad.len();
@@ -166,28 +186,18 @@ pub fn polish(mesh: &mut TetMesh, opts: &PolishOptions) -> PolishReport {
             if done {
                 continue;
             }
-            if !opts.refill {
+            if opts.refill
+                && try_refill(
+                    &mut w,
+                    t,
+                    thr,
+                    &mut searcher,
+                    &rp,
+                    &mut report,
+                    &mut touched,
+                )
+            {
                 continue;
-            }
-            // The tet and its face neighbours, refilled with the moved points (larger cavities,
-            // such as every tet sharing a corner, cost thirty times more for a third more).
-            let mut cav = Vec::new();
-            let label = w.labels[t as usize];
-            cav.push(t);
-            for n in w.nb[t as usize] {
-                if n != NO_NEIGHBOR && w.labels[n as usize] == label && !w.is_forced(n) {
-                    cav.push(n);
-                }
-            }
-            cav.sort_unstable();
-            cav.dedup();
-            report.refills_tried += 1;
-            let c = Instant::now();
-            let r = w.refill(&mut searcher, cav, None, false, thr, &rp);
-            report.ms[3] += c.elapsed().as_secs_f64() * 1e3;
-            if let Some(ids) = r {
-                report.refills_accepted += 1;
-                touched.extend_from_slice(&ids);
             }
         }
         if touched.is_empty() {
@@ -199,13 +209,99 @@ pub fn polish(mesh: &mut TetMesh, opts: &PolishOptions) -> PolishReport {
         bad = scan(&mut w, touched.into_iter(), thr);
     }
     let n = w.tets.len() as u32;
-    let bad = scan(&mut w, 0..n, thr);
+    let mut bad = scan(&mut w, 0..n, thr);
+    if opts.insert {
+        // Steiner points last, once per tet still bad, worst first.
+        let c = Instant::now();
+        let mut any = false;
+        for &(_, t) in &bad {
+            if !w.alive[t as usize] || w.min_angle(t) >= thr {
+                continue;
+            }
+            report.inserts_tried += 1;
+            if w.insert(t, thr, &mut searcher, &rp, &params, &mut star)
+                .is_some()
+            {
+                report.inserts_accepted += 1;
+                any = true;
+            }
+        }
+        if any {
+            let n = w.tets.len() as u32;
+            bad = scan(&mut w, 0..n, thr);
+            // One more round of moves around the tets still bad: the new points (and the
+            // points next to them) may now move.
+            {
+                let mut moved = false;
+                for &(_, t) in &bad {
+                    if !w.alive[t as usize] || w.min_angle(t) >= thr {
+                        continue;
+                    }
+                    for v in w.tets[t as usize] {
+                        if w.fixed[v as usize] {
+                            continue;
+                        }
+                        report.moves_tried += 1;
+                        if w.relocate(v, thr.to_radians(), &params, &mut star) {
+                            report.moves_accepted += 1;
+                            moved = true;
+                        }
+                        if w.min_angle(t) >= thr {
+                            break;
+                        }
+                    }
+                }
+                if moved {
+                    let n = w.tets.len() as u32;
+                    bad = scan(&mut w, 0..n, thr);
+                }
+            }
+        }
+        report.ms[4] = c.elapsed().as_secs_f64() * 1e3;
+    }
     report.n_bad_after = bad.len();
     report.bad_by_interior_corners = by_interior_corners(&w, &bad);
     report.min_unforced_deg = bad.first().map(|x| x.0);
+    report.points_added = (np0..w.pts.len())
+        .filter(|&i| w.vtet[i] != NO_NEIGHBOR)
+        .count();
     w.finish(mesh);
     report.seconds = clock.elapsed().as_secs_f64();
     report
+}
+
+/// Refill `t` and its unforced face neighbours of its label; true when accepted.
+fn try_refill(
+    w: &mut Work,
+    t: u32,
+    thr: f64,
+    searcher: &mut Searcher,
+    rp: &RefillParams,
+    report: &mut PolishReport,
+    touched: &mut Vec<u32>,
+) -> bool {
+    // The tet and its face neighbours, refilled with the moved points (larger cavities,
+    // such as every tet sharing a corner, cost thirty times more for a third more).
+    let mut cav = Vec::new();
+    let label = w.labels[t as usize];
+    cav.push(t);
+    for n in w.nb[t as usize] {
+        if n != NO_NEIGHBOR && w.labels[n as usize] == label && !w.is_forced(n) {
+            cav.push(n);
+        }
+    }
+    cav.sort_unstable();
+    cav.dedup();
+    report.refills_tried += 1;
+    let c = Instant::now();
+    let r = w.refill(searcher, cav, None, false, thr, rp);
+    report.ms[3] += c.elapsed().as_secs_f64() * 1e3;
+    if let Some(ids) = r {
+        report.refills_accepted += 1;
+        touched.extend_from_slice(&ids);
+        return true;
+    }
+    false
 }
 
 /// The live unforced tets of `ts` below `thr` degrees with their angle, worst first.

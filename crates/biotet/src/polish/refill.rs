@@ -26,7 +26,7 @@ pub(super) struct RefillParams {
 }
 
 /// The unforced worst angle, overall worst angle and count below `thr` of `tets`.
-fn judge(w: &mut Work, tets: &[u32], thr: f64) -> (f64, f64, usize) {
+pub(super) fn judge(w: &mut Work, tets: &[u32], thr: f64) -> (f64, f64, usize) {
     let (mut unforced, mut all, mut below) = (f64::INFINITY, f64::INFINITY, 0);
     for &t in tets {
         let a = w.min_angle(t);
@@ -39,21 +39,49 @@ fn judge(w: &mut Work, tets: &[u32], thr: f64) -> (f64, f64, usize) {
     (unforced, all, below)
 }
 
-/// The search's root test, cheaply: every shell face has a point making a tet with it whose
-/// smallest dihedral angle is above `floor` degrees. Such a tet is far from flat, so its
-/// orientation in floating point is certain; without one no fill exists.
-fn every_face_has_candidate(pts: &[P3], shell: &[[u32; 3]], cands: &[u32], floor: f64) -> bool {
-    let s = (floor.to_radians() / 2.0).sin();
-    let lim = 4.0 * s * s;
-    shell.iter().all(|f| {
-        cands.iter().any(|&p| {
-            if f.contains(&p) {
-                return false;
-            }
-            let c = [f[0], f[1], f[2], p].map(|v| pts[v as usize]);
-            volume6(c[0], c[1], c[2], c[3]) > 0.0 && min_dihedral_chord2(&c) > lim
-        })
+/// Whether shell face `f` has a point of `cands` making a tet with it whose smallest dihedral
+/// angle is above `floor` degrees (chord `lim`). Such a tet is far from flat, so its orientation
+/// in floating point is certain.
+fn has_candidate(pts: &[P3], f: &[u32; 3], cands: &[u32], lim: f64) -> bool {
+    cands.iter().any(|&p| {
+        if f.contains(&p) {
+            return false;
+        }
+        let c = [f[0], f[1], f[2], p].map(|v| pts[v as usize]);
+        volume6(c[0], c[1], c[2], c[3]) > 0.0 && min_dihedral_chord2(&c) > lim
     })
+}
+
+fn chord_of(floor: f64) -> f64 {
+    let s = (floor.to_radians() / 2.0).sin();
+    4.0 * s * s
+}
+
+/// The search's root test, cheaply: every shell face has a point making a tet with it whose
+/// smallest dihedral angle is above `floor` degrees; without one no fill exists.
+pub(super) fn every_face_has_candidate(
+    pts: &[P3],
+    shell: &[[u32; 3]],
+    cands: &[u32],
+    floor: f64,
+) -> bool {
+    let lim = chord_of(floor);
+    shell.iter().all(|f| has_candidate(pts, f, cands, lim))
+}
+
+/// How many shell faces have no point making a tet with them above `floor` degrees: every fill
+/// has a tet below `floor` on each of them.
+pub(super) fn faces_without_candidate(
+    pts: &[P3],
+    shell: &[[u32; 3]],
+    cands: &[u32],
+    floor: f64,
+) -> usize {
+    let lim = chord_of(floor);
+    shell
+        .iter()
+        .filter(|f| !has_candidate(pts, f, cands, lim))
+        .count()
 }
 
 impl Work {
@@ -126,7 +154,7 @@ impl Work {
             return Some(ids);
         }
         let back = self.cavity(ids);
-        self.replace(&back, &old_tets);
+        self.replace_in(&back, &old_tets, Some(&cav.tets));
         None
     }
 }

@@ -263,6 +263,17 @@ impl Work {
     /// Swap the cavity's tets for `new` (which fill it exactly) and stitch the adjacency; the
     /// new tets' ids. Points no new tet uses are marked removed when they lose their last tet.
     pub fn replace(&mut self, cav: &Cavity, new: &[[u32; 4]]) -> Vec<u32> {
+        self.replace_in(cav, new, None)
+    }
+
+    /// [`Work::replace`], the new tets taking the dead slots `slots` (one per new tet) when
+    /// given: an undone change puts the old tets back under their old ids.
+    pub fn replace_in(
+        &mut self,
+        cav: &Cavity,
+        new: &[[u32; 4]],
+        slots: Option<&[u32]>,
+    ) -> Vec<u32> {
         let label = self.labels[cav.tets[0] as usize];
         for &t in &cav.tets {
             self.alive[t as usize] = false;
@@ -279,8 +290,12 @@ impl Work {
         }
         let mut inner: FxHashMap<[u32; 3], (u32, u8)> = Default::default();
         let mut ids = Vec::with_capacity(new.len());
-        for tv in new {
-            let t = match self.free.pop() {
+        if let Some(sl) = slots {
+            debug_assert_eq!(sl.len(), new.len());
+            self.free.retain(|x| !sl.contains(x));
+        }
+        for (i, tv) in new.iter().enumerate() {
+            let t = match slots.map(|sl| sl[i]).or_else(|| self.free.pop()) {
                 Some(t) => {
                     self.tets[t as usize] = *tv;
                     self.nb[t as usize] = [NO_NEIGHBOR; 4];

@@ -7,7 +7,7 @@ use biotet::geom::predicates::{Sign, orient3d};
 use biotet::polish::{PolishOptions, polish};
 use biotet::quality::forced::{classify, summarise};
 use biotet::quality::tet::dihedral_angles;
-use biotet::{TET_FACES, TetMesh};
+use biotet::{SurfaceMesh, TET_FACES, TetMesh};
 
 fn min_deg(m: &TetMesh, t: usize) -> f64 {
     dihedral_angles(&m.corners(t))
@@ -110,4 +110,68 @@ fn polish_improves_the_tetgen_brain_mesh() {
     assert!(c.valid, "{c}");
     let v1 = volume(&m);
     assert!((v1 - v0).abs() < 1e-9 * v0, "volume {v1} vs {v0}");
+}
+
+/// A sliver with all four corners on the surface: the bent square `0 1 2 3` (corners 0 and 2
+/// raised) over the apex 4, split into the sliver and the two tets below it. There is no interior
+/// point to move or remove, so with refills off only a Steiner point can fix it: with insertion
+/// off it stays; with it on one interior point is added and every tet ends above 10°.
+#[test]
+fn polish_inserts_a_point_into_a_sliver_with_four_surface_corners() {
+    let h = 0.05;
+    let points = vec![
+        [1.0, 0.0, h],
+        [0.0, 1.0, -h],
+        [-1.0, 0.0, h],
+        [0.0, -1.0, -h],
+        [0.0, 0.0, -1.2],
+    ];
+    let mut tets = vec![[0, 1, 2, 3], [4, 1, 3, 0], [4, 1, 3, 2]];
+    orient_all(&points, &mut tets);
+    let m0 = TetMesh::new(points.clone(), tets, vec![1; 3]);
+    let triangles: Vec<[u32; 3]> = m0
+        .boundary_faces()
+        .map(|(t, f)| TET_FACES[f].map(|k| m0.tets[t][k]))
+        .collect();
+    assert_eq!(triangles.len(), 6);
+    let surface = SurfaceMesh::closed(points.clone(), triangles, 1);
+    assert!(min_deg(&m0, 0) < 10.0, "the sliver is there");
+    let unforced_bad = |m: &TetMesh| {
+        let f = classify(m, &surface, 10.0);
+        summarise(m, &f, 10.0).n_unforced_dihedral_lt_10
+    };
+    assert_eq!(unforced_bad(&m0), 1, "and it is not forced");
+
+    let off = PolishOptions {
+        refill: false,
+        insert: false,
+        ..PolishOptions::default()
+    };
+    let mut m = m0.clone();
+    let r = polish(&mut m, &off);
+    assert_eq!((r.n_bad_before, r.n_bad_after), (1, 1), "{r:?}");
+    assert_eq!(r.points_added, 0);
+    assert_eq!(m.points.len(), 5);
+
+    let on = PolishOptions {
+        insert: true,
+        ..off
+    };
+    let mut m = m0.clone();
+    let r = polish(&mut m, &on);
+    assert_eq!((r.n_bad_before, r.n_bad_after), (1, 0), "{r:?}");
+    assert!(r.inserts_accepted >= 1, "{r:?}");
+    assert_eq!(r.points_added, 1, "{r:?}");
+    assert_eq!(m.points.len(), 6);
+    assert_eq!(&m.points[..5], &points[..], "surface points stay");
+    assert_all_positive(&m);
+    let c = check(&m, Some(&surface));
+    assert!(c.valid, "{c}");
+    assert!((0..m.tets.len()).all(|t| min_deg(&m, t) >= 10.0));
+    assert_eq!(unforced_bad(&m), 0);
+    // The new point is strictly inside: on no boundary face.
+    assert!(
+        m.boundary_faces()
+            .all(|(t, f)| TET_FACES[f].iter().all(|&k| m.tets[t][k] != 5))
+    );
 }

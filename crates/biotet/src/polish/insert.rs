@@ -1,0 +1,345 @@
+//! Steiner points: fix an unforced tet below the threshold with one new interior point.
+//!
+//! The cavity is the tet and its unforced face neighbours of the same label, or, when that fails,
+//! every unforced tet of its label sharing an edge with it (a cavity with an interior point is not
+//! tried). Boundary and interface faces are never crossed, so they stay on the cavity's shell.
+//! The candidates are the tet's centroid and circumcentre, the centroids of the cavity's tets, the
+//! midpoints between the tet's centroid and theirs, the shell's vertex centroid, and points pushed
+//! into the shell's kernel from the two centroids (cyclic projection, floating point).
+//! - If some candidate is seen strictly on the inner side of every shell face (exact `orient3d`),
+//!   the shell is star-shaped from it and its cone fills the cavity exactly: the candidate with
+//!   the best cone is added, the cavity coned to it, and the point moved to raise its star's worst
+//!   unforced angle ([`Work::relocate`]).
+//! - Otherwise the candidate strictly inside a cavity tet (exact) that makes a tet above the
+//!   threshold with the most shell faces is added, and only the search can fill the cavity.
+//!
+//! Unless every tet is then above the threshold, the LAST RESORT search refills the cavity with
+//! the point as an inner point every fill uses: first every tet above the threshold, then (face
+//! cavities only) every tet above the cavity's worst before. The result is kept only if the
+//! cavity's worst unforced angle rises, its worst angle does not fall and no more of its tets are
+//! below the threshold; otherwise the old tets come back under their ids and the point is dropped.
+
+use rustc_hash::FxHashSet;
+
+use crate::geom::predicates::{Sign, in_exact_range, orient3d};
+use crate::geom::vec3::{add, cross, dot, norm2, scale, sub, volume6};
+use crate::lastresort::{SearchOptions, Searcher};
+use crate::mesh::tet::NO_NEIGHBOR;
+use crate::quality::tet::min_dihedral_chord2;
+
+use super::refill::{RefillParams, every_face_has_candidate, faces_without_candidate, judge};
+use super::relocate::StepParams;
+use super::work::{P3, Work};
+
+impl Work {
+    /// Try to raise `t` (unforced, below `thr` degrees) with one new interior point; the new
+    /// tets when accepted. `star` is scratch.
+    pub fn insert(
+        &mut self,
+        t: u32,
+        thr: f64,
+        searcher: &mut Searcher,
+        rp: &RefillParams,
+        sp: &StepParams,
+        star: &mut Vec<u32>,
+    ) -> Option<Vec<u32>> {
+        let label = self.labels[t as usize];
+        let mut faces = vec![t];
+        for n in self.nb[t as usize] {
+            if n != NO_NEIGHBOR && self.labels[n as usize] == label && !self.is_forced(n) {
+                faces.push(n);
+            }
+        }
+        faces.sort_unstable();
+        if let Some(ids) = self.insert_into(t, faces.clone(), thr, searcher, rp, sp, star) {
+            return Some(ids);
+        }
+        // Every tet of the label sharing an edge (two corners) with t.
+        let tv = self.tets[t as usize];
+        let mut edges = Vec::new();
+        for v in tv {
+            self.star(v, star);
+            for &s in star.iter() {
+                let shared = self.tets[s as usize]
+                    .iter()
+                    .filter(|x| tv.contains(x))
+                    .count();
+                if shared >= 2 && self.labels[s as usize] == label && (s == t || !self.is_forced(s))
+                {
+                    edges.push(s);
+                }
+            }
+        }
+        edges.sort_unstable();
+        edges.dedup();
+        if edges == faces {
+            return None;
+        }
+        self.insert_into(t, edges, thr, searcher, rp, sp, star)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn insert_into(
+        &mut self,
+        t: u32,
+        tets: Vec<u32>,
+        thr: f64,
+        searcher: &mut Searcher,
+        rp: &RefillParams,
+        sp: &StepParams,
+        star: &mut Vec<u32>,
+    ) -> Option<Vec<u32>> {
+        if tets.len() > rp.max_tets {
+            return None;
+        }
+        // Past the face cavity (at most five tets), only fills with every tet above the
+        // threshold are searched: the lower floor's fills there cost twice as much per
+        // insertion kept.
+        let large = tets.len() > 5;
+        let cav = self.cavity(tets);
+        let on_shell: FxHashSet<u32> = cav.shell.iter().flatten().copied().collect();
+        if cav
+            .tets
+            .iter()
+            .any(|&s| self.tets[s as usize].iter().any(|v| !on_shell.contains(v)))
+        {
+            return None;
+        }
+        let (x, cone_ok) = self.best_point(t, &cav.tets, &cav.shell, thr)?;
+        let old = judge(self, &cav.tets, thr);
+        let old_tets: Vec<[u32; 4]> = cav.tets.iter().map(|&s| self.tets[s as usize]).collect();
+        let p = self.pts.len() as u32;
+        self.pts.push(x);
+        self.vtet.push(NO_NEIGHBOR);
+        self.fixed.push(false);
+        // With a star-shaped shell, the cone, the point moved; otherwise the old tets, and only a
+        // fill the search finds replaces them.
+        let (mut ids, mut new) = if cone_ok {
+            let cone: Vec<[u32; 4]> = cav.shell.iter().map(|f| [f[0], f[1], f[2], p]).collect();
+            let ids = self.replace(&cav, &cone);
+            self.relocate(p, thr.to_radians(), sp, star);
+            let new = judge(self, &ids, thr);
+            (ids, new)
+        } else {
+            (
+                cav.tets.clone(),
+                (f64::NEG_INFINITY, f64::NEG_INFINITY, usize::MAX),
+            )
+        };
+        let mut filled = cone_ok;
+        if new.2 > 0 {
+            // The search, with the point as the one inner point: first every tet above the
+            // threshold, then every tet above the cavity's worst before (any other fill would be
+            // rejected).
+            let mut cands: Vec<u32> = on_shell.iter().copied().chain([p]).collect();
+            cands.sort_unstable();
+            // A tet covers at most four shell faces, so a fill has at least a quarter of the faces
+            // with no tet above the threshold below it: more than before, and no fill can pass.
+            let poor = faces_without_candidate(&self.pts, &cav.shell, &cands, thr);
+            for floor in [thr, old.1.max(0.0) * (1.0 + 1e-9)] {
+                if floor < thr && (large || poor.div_ceil(4) > old.2) {
+                    break;
+                }
+                if !every_face_has_candidate(&self.pts, &cav.shell, &cands, floor) {
+                    continue;
+                }
+                let so = SearchOptions {
+                    min_quality: 0.0,
+                    min_dihedral: floor,
+                    max_nodes: rp.max_nodes,
+                    improve: Some(rp.improve_nodes),
+                };
+                let r = searcher.fill(&self.pts, &cav.shell, &[p], &so);
+                if let Ok(f) = r {
+                    let cur = self.cavity(ids);
+                    ids = self.replace(&cur, &f.tets);
+                    new = judge(self, &ids, thr);
+                    filled = true;
+                    break;
+                }
+            }
+        }
+        if new.0 > old.0 && new.1 >= old.1 && new.2 <= old.2 {
+            return Some(ids);
+        }
+        if filled {
+            let back = self.cavity(ids);
+            self.replace_in(&back, &old_tets, Some(&cav.tets));
+        }
+        debug_assert_eq!(self.vtet[p as usize], NO_NEIGHBOR);
+        self.pts.pop();
+        self.vtet.pop();
+        self.fixed.pop();
+        None
+    }
+
+    /// The candidate point whose cone over `shell` has the largest smallest dihedral angle among
+    /// those strictly inside every shell face's half-space (exact), with `true`; when there is
+    /// none, the candidate strictly inside a tet of `tets` (exact) that makes a tet above `thr`
+    /// degrees with the most shell faces, with `false`.
+    fn best_point(&self, t: u32, tets: &[u32], shell: &[[u32; 3]], thr: f64) -> Option<(P3, bool)> {
+        let c = self.corners(t);
+        let ct = centroid(&c);
+        let mut cands = vec![ct];
+        if let Some(o) = circumcentre(&c) {
+            cands.push(o);
+        }
+        for &s in tets {
+            if s != t {
+                let cs = centroid(&self.corners(s));
+                cands.push(cs);
+                cands.push(scale(add(ct, cs), 0.5));
+            }
+        }
+        let mut sum = [0.0; 3];
+        let mut n = 0;
+        let mut seen: Vec<u32> = shell.iter().flatten().copied().collect();
+        seen.sort_unstable();
+        seen.dedup();
+        for &v in &seen {
+            sum = add(sum, self.pts[v as usize]);
+            n += 1;
+        }
+        let sc = scale(sum, 1.0 / n as f64);
+        cands.push(sc);
+        // Points pushed into the shell's kernel (cyclic projection onto the faces' half-spaces
+        // moved inward by a margin), from the tet's and the shell's centroids.
+        let planes: Vec<(P3, P3)> = shell
+            .iter()
+            .filter_map(|f| {
+                let q = [f[0], f[1], f[2]].map(|v| self.pts[v as usize]);
+                let nv = cross(sub(q[1], q[0]), sub(q[2], q[0]));
+                let l = norm2(nv).sqrt();
+                (l > 0.0).then(|| (q[0], scale(nv, 1.0 / l)))
+            })
+            .collect();
+        let vol: f64 = tets
+            .iter()
+            .map(|&s| {
+                let c = self.corners(s);
+                volume6(c[0], c[1], c[2], c[3]) / 6.0
+            })
+            .sum();
+        let h = vol.max(0.0).cbrt();
+        for start in [ct, sc] {
+            for m in [0.2, 0.07, 0.02] {
+                if let Some(x) = kernel_point(&planes, start, m * h) {
+                    cands.push(x);
+                }
+            }
+        }
+        let mut scored: Vec<(f64, usize)> = Vec::new();
+        'c: for (i, x) in cands.iter().enumerate() {
+            if !x.iter().all(|&k| in_exact_range(k)) {
+                continue;
+            }
+            // Every face sees it (floating point first), then the cone's worst tet.
+            for f in shell {
+                let q = [f[0], f[1], f[2]].map(|v| self.pts[v as usize]);
+                if volume6(q[0], q[1], q[2], *x) <= 0.0 {
+                    continue 'c;
+                }
+            }
+            let mut worst = f64::INFINITY;
+            for f in shell {
+                let q = [f[0], f[1], f[2]].map(|v| self.pts[v as usize]);
+                worst = worst.min(min_dihedral_chord2(&[q[0], q[1], q[2], *x]));
+            }
+            if worst.is_finite() {
+                scored.push((worst, i));
+            }
+        }
+        scored.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+        let star = scored.into_iter().map(|(_, i)| cands[i]).find(|x| {
+            shell.iter().all(|f| {
+                let q = [f[0], f[1], f[2]].map(|v| self.pts[v as usize]);
+                orient3d(q[0], q[1], q[2], *x) == Sign::Positive
+            })
+        });
+        if let Some(x) = star {
+            return Some((x, true));
+        }
+        let s = (thr.to_radians() / 2.0).sin();
+        let lim = 4.0 * s * s;
+        let mut best: Option<(usize, P3)> = None;
+        for x in cands {
+            if !x.iter().all(|&k| in_exact_range(k)) {
+                continue;
+            }
+            let inside = tets.iter().any(|&s| {
+                let c = self.corners(s);
+                let sees = |k: usize| {
+                    let mut d = c;
+                    d[k] = x;
+                    d
+                };
+                (0..4).all(|k| {
+                    let d = sees(k);
+                    volume6(d[0], d[1], d[2], d[3]) > 0.0
+                }) && (0..4).all(|k| {
+                    let d = sees(k);
+                    orient3d(d[0], d[1], d[2], d[3]) == Sign::Positive
+                })
+            });
+            if !inside {
+                continue;
+            }
+            let floor = best.map_or(0, |b| b.0);
+            let mut served = 0;
+            for (i, f) in shell.iter().enumerate() {
+                if served + (shell.len() - i) <= floor {
+                    break;
+                }
+                let q = [f[0], f[1], f[2]].map(|v| self.pts[v as usize]);
+                let c = [q[0], q[1], q[2], x];
+                if volume6(c[0], c[1], c[2], c[3]) > 0.0 && min_dihedral_chord2(&c) > lim {
+                    served += 1;
+                }
+            }
+            if best.is_none() || served > floor {
+                best = Some((served, x));
+            }
+        }
+        best.map(|b| (b.1, false))
+    }
+}
+
+/// A point at least `margin` inside every plane `(point, unit inward normal)`, by cyclic
+/// projection from `x` (floating point; the caller decides exactly).
+fn kernel_point(planes: &[(P3, P3)], mut x: P3, margin: f64) -> Option<P3> {
+    for _ in 0..40 {
+        let mut worst = (0.0, usize::MAX);
+        for (i, (q, n)) in planes.iter().enumerate() {
+            let d = dot(*n, sub(x, *q)) - margin;
+            if d < worst.0 {
+                worst = (d, i);
+            }
+        }
+        if worst.1 == usize::MAX {
+            return Some(x);
+        }
+        x = add(x, scale(planes[worst.1].1, -worst.0 * 1.01));
+    }
+    None
+}
+
+fn centroid(c: &[P3; 4]) -> P3 {
+    scale(add(add(c[0], c[1]), add(c[2], c[3])), 0.25)
+}
+
+/// The circumcentre of a tet (None when flat in floating point).
+fn circumcentre(c: &[P3; 4]) -> Option<P3> {
+    let a = sub(c[1], c[0]);
+    let b = sub(c[2], c[0]);
+    let d = sub(c[3], c[0]);
+    let den = 2.0 * dot(a, cross(b, d));
+    if den == 0.0 || !den.is_finite() {
+        return None;
+    }
+    let num = add(
+        add(scale(cross(b, d), norm2(a)), scale(cross(d, a), norm2(b))),
+        scale(cross(a, b), norm2(d)),
+    );
+    let o = add(c[0], scale(num, 1.0 / den));
+    o.iter().all(|k| k.is_finite()).then_some(o)
+}
