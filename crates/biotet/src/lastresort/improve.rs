@@ -33,7 +33,7 @@ use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 use std::time::Instant;
 
-use rustc_hash::{FxHashMap, FxHashSet};
+use rustc_hash::FxHashSet;
 use serde::Serialize;
 
 use super::search::{Fill, SearchError, SearchOptions, Searcher};
@@ -333,41 +333,21 @@ impl View<'_> {
     fn cavity(&self, tets: Vec<u32>, mark: &mut FxHashSet<u32>) -> Cavity {
         mark.clear();
         mark.extend(tets.iter().copied());
-        let mut shell = Vec::new();
-        let mut outer = Vec::new();
-        let mut on_shell: FxHashSet<u32> = Default::default();
-        let mut all: Vec<u32> = Vec::new();
-        for &t in &tets {
-            let v = self.tets[t as usize];
-            all.extend_from_slice(&v);
-            for (i, l) in TET_FACES.iter().enumerate() {
-                let n = self.nb[t as usize][i];
-                if n != NO_NEIGHBOR && mark.contains(&n) {
-                    continue;
-                }
-                // Outward face reversed: the normal points into the cavity.
-                let f = [v[l[0]], v[l[2]], v[l[1]]];
-                on_shell.extend(f);
-                shell.push(f);
-                let j = if n == NO_NEIGHBOR {
-                    0
-                } else {
-                    self.nb[n as usize]
-                        .iter()
-                        .position(|&x| x == t)
-                        .unwrap_or(0) as u8
-                };
-                outer.push((n, j));
-            }
-        }
+        let (shell, outer) =
+            crate::mesh::cavity::shell(&tets, self.tets, self.nb, |n| mark.contains(&n));
+        let on_shell: FxHashSet<u32> = shell.iter().flatten().copied().collect();
+        let mut all: Vec<u32> = tets
+            .iter()
+            .flat_map(|&t| self.tets[t as usize])
+            .filter(|v| !on_shell.contains(v))
+            .collect();
         all.sort_unstable();
         all.dedup();
-        let inner = all.into_iter().filter(|v| !on_shell.contains(v)).collect();
         Cavity {
             tets,
             shell,
             outer,
-            inner,
+            inner: all,
         }
     }
 
@@ -539,14 +519,6 @@ impl<'a> Work<'a> {
             self.alive[t as usize] = false;
             self.free.push(t);
         }
-        // Shell faces by vertex set -> the tet outside and its local face.
-        let mut outside: FxHashMap<[u32; 3], (u32, u8)> = Default::default();
-        for (f, &o) in cav.shell.iter().zip(&cav.outer) {
-            let mut k = *f;
-            k.sort_unstable();
-            outside.insert(k, o);
-        }
-        let mut inner_faces: FxHashMap<[u32; 3], (u32, u8)> = Default::default();
         let mut ids = Vec::with_capacity(new.len());
         for tv in new {
             let t = match self.free.pop() {
@@ -578,25 +550,7 @@ impl<'a> Work<'a> {
                 self.vtet[v as usize] = t;
             }
         }
-        for &t in &ids {
-            let tv = self.tets[t as usize];
-            for (i, l) in TET_FACES.iter().enumerate() {
-                let mut k = [tv[l[0]], tv[l[1]], tv[l[2]]];
-                k.sort_unstable();
-                if let Some(&(n, j)) = outside.get(&k) {
-                    self.nb[t as usize][i] = n;
-                    if n != NO_NEIGHBOR {
-                        self.nb[n as usize][j as usize] = t;
-                    }
-                } else if let Some((u, j)) = inner_faces.remove(&k) {
-                    self.nb[t as usize][i] = u;
-                    self.nb[u as usize][j as usize] = t;
-                } else {
-                    inner_faces.insert(k, (t, i as u8));
-                }
-            }
-        }
-        debug_assert!(inner_faces.is_empty());
+        crate::mesh::cavity::stitch(&self.tets, &mut self.nb, &ids, &cav.shell, &cav.outer);
         for &t in &ids {
             let v = self.value(t);
             if v < self.opts.threshold && self.rounds[t as usize] <= self.opts.max_rounds {

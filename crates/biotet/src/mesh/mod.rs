@@ -4,6 +4,7 @@
 //!
 //! All three are flat arrays with `u32` indices, cheap to hand to numpy, VTK or a solver.
 
+pub mod cavity;
 pub mod inside;
 pub mod pslg;
 pub mod shells;

@@ -1,8 +1,6 @@
 //! The mesh being polished: tets with tombstones, adjacency, one incident tet per point, which
 //! points are fixed (on a boundary or interface face) and which tets the input forces poor.
 
-use rustc_hash::FxHashMap;
-
 use crate::mesh::tet::{NO_NEIGHBOR, TET_EDGES, TET_FACES, TetMesh};
 use crate::quality::tet::{dihedral_angles, dihedral_at};
 use crate::quality::tri::min_angle_3d_deg;
@@ -235,28 +233,8 @@ impl Work {
 
     /// The cavity of `tets` (all of one label).
     pub fn cavity(&self, tets: Vec<u32>) -> Cavity {
-        let mut shell = Vec::new();
-        let mut outer = Vec::new();
-        for &t in &tets {
-            let v = self.tets[t as usize];
-            for (i, l) in TET_FACES.iter().enumerate() {
-                let n = self.nb[t as usize][i];
-                if n != NO_NEIGHBOR && tets.contains(&n) {
-                    continue;
-                }
-                // Outward face reversed: the normal points into the cavity.
-                shell.push([v[l[0]], v[l[2]], v[l[1]]]);
-                let j = if n == NO_NEIGHBOR {
-                    0
-                } else {
-                    self.nb[n as usize]
-                        .iter()
-                        .position(|&x| x == t)
-                        .unwrap_or(0) as u8
-                };
-                outer.push((n, j));
-            }
-        }
+        let (shell, outer) =
+            crate::mesh::cavity::shell(&tets, &self.tets, &self.nb, |n| tets.contains(&n));
         Cavity { tets, shell, outer }
     }
 
@@ -282,13 +260,6 @@ impl Work {
                 self.vtet[v as usize] = NO_NEIGHBOR;
             }
         }
-        let mut outside: FxHashMap<[u32; 3], (u32, u8)> = Default::default();
-        for (f, &o) in cav.shell.iter().zip(&cav.outer) {
-            let mut k = *f;
-            k.sort_unstable();
-            outside.insert(k, o);
-        }
-        let mut inner: FxHashMap<[u32; 3], (u32, u8)> = Default::default();
         let mut ids = Vec::with_capacity(new.len());
         if let Some(sl) = slots {
             debug_assert_eq!(sl.len(), new.len());
@@ -316,27 +287,11 @@ impl Work {
             ids.push(t);
         }
         for &t in &ids {
-            let tv = self.tets[t as usize];
-            for &v in &tv {
+            for v in self.tets[t as usize] {
                 self.vtet[v as usize] = t;
             }
-            for (i, l) in TET_FACES.iter().enumerate() {
-                let mut k = [tv[l[0]], tv[l[1]], tv[l[2]]];
-                k.sort_unstable();
-                if let Some(&(n, j)) = outside.get(&k) {
-                    self.nb[t as usize][i] = n;
-                    if n != NO_NEIGHBOR {
-                        self.nb[n as usize][j as usize] = t;
-                    }
-                } else if let Some((u, j)) = inner.remove(&k) {
-                    self.nb[t as usize][i] = u;
-                    self.nb[u as usize][j as usize] = t;
-                } else {
-                    inner.insert(k, (t, i as u8));
-                }
-            }
         }
-        debug_assert!(inner.is_empty());
+        crate::mesh::cavity::stitch(&self.tets, &mut self.nb, &ids, &cav.shell, &cav.outer);
         // Shell corners keep a live tet outside the cavity when no new tet uses them.
         for (f, &(n, _)) in cav.shell.iter().zip(&cav.outer) {
             for &v in f {
