@@ -144,22 +144,17 @@ pub fn polish(mesh: &mut TetMesh, opts: &PolishOptions) -> PolishReport {
             if !w.alive[t as usize] || w.min_angle(t) >= thr {
                 continue;
             }
-            for v in w.tets[t as usize] {
-                if w.fixed[v as usize] {
-                    continue;
-                }
-                report.moves_tried += 1;
-                let c = Instant::now();
-                let ok = w.relocate(v, thr.to_radians(), &params, &mut star);
-                report.ms[1] += c.elapsed().as_secs_f64() * 1e3;
-                if ok {
-                    report.moves_accepted += 1;
-                    touched.extend_from_slice(&star);
-                }
-                if w.min_angle(t) >= thr {
-                    break;
-                }
-            }
+            let c = Instant::now();
+            move_corners(
+                &mut w,
+                t,
+                thr,
+                &params,
+                &mut star,
+                &mut report,
+                &mut touched,
+            );
+            report.ms[1] += c.elapsed().as_secs_f64() * 1e3;
             if w.min_angle(t) >= thr {
                 continue;
             }
@@ -234,21 +229,17 @@ pub fn polish(mesh: &mut TetMesh, opts: &PolishOptions) -> PolishReport {
             {
                 let mut moved = false;
                 for &(_, t) in &bad {
-                    if !w.alive[t as usize] || w.min_angle(t) >= thr {
-                        continue;
-                    }
-                    for v in w.tets[t as usize] {
-                        if w.fixed[v as usize] {
-                            continue;
-                        }
-                        report.moves_tried += 1;
-                        if w.relocate(v, thr.to_radians(), &params, &mut star) {
-                            report.moves_accepted += 1;
-                            moved = true;
-                        }
-                        if w.min_angle(t) >= thr {
-                            break;
-                        }
+                    if w.alive[t as usize] && w.min_angle(t) < thr {
+                        let mut touched = Vec::new();
+                        moved |= move_corners(
+                            &mut w,
+                            t,
+                            thr,
+                            &params,
+                            &mut star,
+                            &mut report,
+                            &mut touched,
+                        );
                     }
                 }
                 if moved {
@@ -302,6 +293,35 @@ fn try_refill(
         return true;
     }
     false
+}
+
+/// Move the interior corners of bad tet `t`, one at a time, until it is above `thr`; the moved
+/// corners' stars go to `touched`. True when any corner moved.
+fn move_corners(
+    w: &mut Work,
+    t: u32,
+    thr: f64,
+    params: &StepParams,
+    star: &mut Vec<u32>,
+    report: &mut PolishReport,
+    touched: &mut Vec<u32>,
+) -> bool {
+    let mut moved = false;
+    for v in w.tets[t as usize] {
+        if w.fixed[v as usize] {
+            continue;
+        }
+        report.moves_tried += 1;
+        if w.relocate(v, thr.to_radians(), params, star) {
+            report.moves_accepted += 1;
+            touched.extend_from_slice(star);
+            moved = true;
+        }
+        if w.min_angle(t) >= thr {
+            break;
+        }
+    }
+    moved
 }
 
 /// The live unforced tets of `ts` below `thr` degrees with their angle, worst first.
