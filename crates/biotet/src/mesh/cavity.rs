@@ -75,3 +75,69 @@ pub fn stitch(
     }
     debug_assert!(open.is_empty(), "the new tets do not fill the cavity");
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::delaunay::Delaunay;
+
+    /// Carving the star of a point and putting the same tets back under new ids: the shell and
+    /// the stitch give back exactly the adjacency a full rebuild gives.
+    #[test]
+    fn stitch_restores_the_adjacency_of_a_refilled_star() {
+        let mut pts = Vec::new();
+        let mut s = 7u64;
+        for _ in 0..300 {
+            let mut c = [0.0; 3];
+            for x in &mut c {
+                s = s
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                *x = (s >> 11) as f64 / (1u64 << 53) as f64;
+            }
+            pts.push(c);
+        }
+        let mesh = Delaunay::new(&pts).unwrap().to_tet_mesh();
+        let (mut tets, mut nb) = (mesh.tets.clone(), mesh.neighbors.clone());
+        // The star of the first corner of tet 0.
+        let v = tets[0][0];
+        let star: Vec<u32> = (0..tets.len() as u32)
+            .filter(|&t| tets[t as usize].contains(&v))
+            .collect();
+        assert!(star.len() > 4);
+        let (shell_faces, outer) = shell(&star, &tets, &nb, |t| star.contains(&t));
+        assert!(outer.iter().any(|&(n, _)| n != NO_NEIGHBOR));
+        // The same tets back at the end of the arrays, the old slots dead.
+        let ids: Vec<u32> = star
+            .iter()
+            .map(|&t| {
+                tets.push(tets[t as usize]);
+                nb.push([NO_NEIGHBOR; 4]);
+                (tets.len() - 1) as u32
+            })
+            .collect();
+        stitch(&tets, &mut nb, &ids, &shell_faces, &outer);
+        let live: Vec<u32> = (0..tets.len() as u32)
+            .filter(|t| !star.contains(t))
+            .collect();
+        let mut index = vec![NO_NEIGHBOR; tets.len()];
+        for (k, &t) in live.iter().enumerate() {
+            index[t as usize] = k as u32;
+        }
+        let kept: Vec<[u32; 4]> = live.iter().map(|&t| tets[t as usize]).collect();
+        let got: Vec<[u32; 4]> = live
+            .iter()
+            .map(|&t| {
+                nb[t as usize].map(|n| {
+                    if n == NO_NEIGHBOR {
+                        n
+                    } else {
+                        index[n as usize]
+                    }
+                })
+            })
+            .collect();
+        let (want, _) = crate::mesh::tet::face_adjacency(&kept);
+        assert_eq!(got, want);
+    }
+}
