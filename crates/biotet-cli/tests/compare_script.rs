@@ -7,78 +7,6 @@ use serde_json::Value;
 use std::process::Command;
 use support::*;
 
-/// An icosahedron subdivided twice onto the sphere of radius 10 (320 triangles), as OFF.
-fn icosphere_off() -> String {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut pts: Vec<[f64; 3]> = vec![
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ];
-    let mut tris: Vec<[usize; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    let project = |p: [f64; 3]| {
-        let n = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
-        p.map(|c| 10.0 * c / n)
-    };
-    for p in pts.iter_mut() {
-        *p = project(*p);
-    }
-    for _ in 0..2 {
-        let mut mid = std::collections::HashMap::new();
-        let mut next = Vec::new();
-        for [a, b, c] in tris {
-            let mut m = |i: usize, j: usize| {
-                *mid.entry((i.min(j), i.max(j))).or_insert_with(|| {
-                    let (p, q) = (pts[i], pts[j]);
-                    pts.push(project([0, 1, 2].map(|k| (p[k] + q[k]) / 2.0)));
-                    pts.len() - 1
-                })
-            };
-            let (ab, bc, ca) = (m(a, b), m(b, c), m(c, a));
-            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        tris = next;
-    }
-    let mut s = format!("OFF\n{} {} 0\n", pts.len(), tris.len());
-    for p in &pts {
-        s += &format!("{} {} {}\n", p[0], p[1], p[2]);
-    }
-    for t in &tris {
-        s += &format!("3 {} {} {}\n", t[0], t[1], t[2]);
-    }
-    s
-}
-
 #[test]
 fn compare_script_runs_every_installed_tool_on_a_small_sphere() {
     let probe = Command::new("python3")
@@ -112,7 +40,9 @@ fn compare_script_runs_every_installed_tool_on_a_small_sphere() {
     assert!(installed.iter().any(|t| t == "biotet"), "{list}");
 
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("sphere.off"), icosphere_off()).unwrap();
+    // An icosahedron subdivided twice onto the sphere of radius 10 (320 triangles).
+    let sphere = biotet::mesh::surface::SurfaceMesh::icosphere(10.0, 2);
+    biotet_io::write_surface(&dir.path().join("sphere.off"), &sphere).unwrap();
     let out = Command::new("python3")
         .current_dir(dir.path())
         .arg(&script)

@@ -18,6 +18,75 @@ pub struct SurfaceMesh {
 }
 
 impl SurfaceMesh {
+    /// An icosphere of radius `r` centred at the origin: the icosahedron, `levels` times split
+    /// into four, its points pushed onto the sphere at the end; outward, one region (label 1).
+    /// A test and benchmark shape.
+    pub fn icosphere(r: f64, levels: usize) -> SurfaceMesh {
+        let g = (1.0 + 5f64.sqrt()) / 2.0;
+        let mut p: Vec<[f64; 3]> = vec![
+            [-1.0, g, 0.0],
+            [1.0, g, 0.0],
+            [-1.0, -g, 0.0],
+            [1.0, -g, 0.0],
+            [0.0, -1.0, g],
+            [0.0, 1.0, g],
+            [0.0, -1.0, -g],
+            [0.0, 1.0, -g],
+            [g, 0.0, -1.0],
+            [g, 0.0, 1.0],
+            [-g, 0.0, -1.0],
+            [-g, 0.0, 1.0],
+        ];
+        let mut t: Vec<[u32; 3]> = vec![
+            [0, 11, 5],
+            [0, 5, 1],
+            [0, 1, 7],
+            [0, 7, 10],
+            [0, 10, 11],
+            [1, 5, 9],
+            [5, 11, 4],
+            [11, 10, 2],
+            [10, 7, 6],
+            [7, 1, 8],
+            [3, 9, 4],
+            [3, 4, 2],
+            [3, 2, 6],
+            [3, 6, 8],
+            [3, 8, 9],
+            [4, 9, 5],
+            [2, 4, 11],
+            [6, 2, 10],
+            [8, 6, 7],
+            [9, 8, 1],
+        ];
+        for _ in 0..levels {
+            let mut mid = std::collections::HashMap::new();
+            let mut next = Vec::new();
+            for tri in &t {
+                let mut m = [0u32; 3];
+                for k in 0..3 {
+                    let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                    let key = (a.min(b), a.max(b));
+                    m[k] = *mid.entry(key).or_insert_with(|| {
+                        let (pa, pb) = (p[a as usize], p[b as usize]);
+                        p.push([0, 1, 2].map(|i| (pa[i] + pb[i]) / 2.0));
+                        (p.len() - 1) as u32
+                    });
+                }
+                next.push([tri[0], m[0], m[2]]);
+                next.push([tri[1], m[1], m[0]]);
+                next.push([tri[2], m[2], m[1]]);
+                next.push(m);
+            }
+            t = next;
+        }
+        for q in &mut p {
+            let l = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt();
+            *q = q.map(|c| c * r / l);
+        }
+        Self::closed(p, t, 1)
+    }
+
     /// A closed boundary of one region: every triangle gets `[label, 0]`.
     pub fn closed(points: Vec<[f64; 3]>, triangles: Vec<[u32; 3]>, label: u32) -> SurfaceMesh {
         let sides = vec![[label, 0]; triangles.len()];

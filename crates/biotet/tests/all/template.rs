@@ -1,7 +1,7 @@
 //! Node deployment (chapter 2): the exact inside test, the template, the deployed nodes and the
 //! pipeline's output.
 
-use crate::common::{cube_surface, icosphere, load_stl, octahedron, point_triangle_distance};
+use crate::common::{cube_surface, load_stl, octahedron, point_triangle_distance};
 use biotet::SurfaceMesh;
 use biotet::check::check;
 use biotet::mesh::inside::{Location, RegionLocator};
@@ -193,7 +193,7 @@ fn spacing_and_clearance(s: &SurfaceMesh, h: f64, zone: Zone) -> (f64, f64, f64)
 fn sphere_and_cube_spacing_and_clearance() {
     // A sphere whose triangles match the size, and a cube of 12 triangles far larger than the
     // size (every one sealed by a prism).
-    let sphere = icosphere(10.0, 3); // edges about 1.9
+    let sphere = SurfaceMesh::icosphere(10.0, 3); // edges about 1.9
     let cube = cube_surface([0.0; 3], 12.0);
     for zone in [Zone::Euclidean, Zone::Box] {
         for (s, h) in [(&sphere, 2.0), (&cube, 1.5)] {
@@ -216,7 +216,7 @@ fn sphere_and_cube_spacing_and_clearance() {
 
 #[test]
 fn deployment_is_deterministic_and_template_is_one_byte_per_voxel() {
-    let s = icosphere(10.0, 2);
+    let s = SurfaceMesh::icosphere(10.0, 2);
     let sizing = Sizing::uniform(1.5).unwrap();
     let a = deploy(&s, &sizing, &DeployOptions::default()).unwrap();
     let b = deploy(&s, &sizing, &DeployOptions::default()).unwrap();
