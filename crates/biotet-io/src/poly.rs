@@ -36,6 +36,35 @@ pub struct PslgRead {
 }
 
 /// Read the segments of a `.poly` (after its points) or an `.edge` file.
+/// The `n` lines of a counted section (`what`, plural), each with at least `min` numbers as
+/// `usage` shows, handed to `row`.
+fn rows<'a>(
+    lx: &mut Lexer<'a>,
+    toks: &mut Vec<&'a [u8]>,
+    n: usize,
+    what: &str,
+    min: usize,
+    usage: &str,
+    mut row: impl FnMut(&Lexer<'a>, &[&'a [u8]]) -> Result<()>,
+) -> Result<()> {
+    for i in 0..n {
+        if !lx.line_tokens(toks) {
+            return Err(Error::truncated(
+                lx.file,
+                format!("expected {n} {what}, found {i}"),
+            ));
+        }
+        if toks.len() < min {
+            return Err(lx.err(format!(
+                "expected {usage} in the {what}, got {} numbers",
+                toks.len()
+            )));
+        }
+        row(lx, toks)?;
+    }
+    Ok(())
+}
+
 fn segments<'a>(
     lx: &mut Lexer<'a>,
     toks: &mut Vec<&'a [u8]>,
@@ -55,20 +84,11 @@ fn segments<'a>(
         Some(t) => lx.tok_u64(t, "number of boundary markers")? > 0,
         None => false,
     };
-    for i in 0..n {
-        if !lx.line_tokens(toks) {
-            return Err(Error::truncated(
-                lx.file,
-                format!("expected {n} {what}, found {i}"),
-            ));
-        }
-        if toks.len() < 3 {
-            return Err(lx.err(format!(
-                "expected '<index> <point> <point>{}', got {} numbers",
-                if markers { " <marker>" } else { "" },
-                toks.len()
-            )));
-        }
+    let usage = format!(
+        "'<index> <point> <point>{}'",
+        if markers { " <marker>" } else { "" }
+    );
+    rows(lx, toks, n, what, 3, &usage, |lx, toks| {
         lx.tok_u64(toks[0], "segment index")?;
         let mut s = [0u32; 2];
         for (x, t) in s.iter_mut().zip(&toks[1..3]) {
@@ -92,8 +112,8 @@ fn segments<'a>(
         };
         g.segments.push(s);
         g.segment_markers.push(m);
-    }
-    Ok(())
+        Ok(())
+    })
 }
 
 /// Parse a `.poly` held in memory; `node` gives the sibling `.node` data when the `.poly` lists no
@@ -126,33 +146,23 @@ pub fn parse_poly(data: &[u8], file: &str, node: Option<(&[u8], &str)>) -> Resul
     // Holes (a missing section means none).
     if lx.line_tokens(&mut toks) {
         let nh = lx.tok_u64(toks[0], "number of holes")? as usize;
-        for i in 0..nh {
-            if !lx.line_tokens(&mut toks) {
-                return Err(Error::truncated(
-                    file,
-                    format!("expected {nh} holes, found {i}"),
-                ));
-            }
-            if toks.len() < 3 {
-                return Err(lx.err("expected '<index> <x> <y>' for a hole"));
-            }
-            g.holes
-                .push([lx.tok_f64(toks[1], "x")?, lx.tok_f64(toks[2], "y")?]);
-        }
+        rows(
+            &mut lx,
+            &mut toks,
+            nh,
+            "holes",
+            3,
+            "'<index> <x> <y>'",
+            |lx, toks| {
+                g.holes
+                    .push([lx.tok_f64(toks[1], "x")?, lx.tok_f64(toks[2], "y")?]);
+                Ok(())
+            },
+        )?;
         if lx.line_tokens(&mut toks) {
             let nr = lx.tok_u64(toks[0], "number of regions")? as usize;
-            for i in 0..nr {
-                if !lx.line_tokens(&mut toks) {
-                    return Err(Error::truncated(
-                        file,
-                        format!("expected {nr} regions, found {i}"),
-                    ));
-                }
-                if toks.len() < 4 {
-                    return Err(
-                        lx.err("expected '<index> <x> <y> <label> [<max area>]' for a region")
-                    );
-                }
+            let usage = "'<index> <x> <y> <label> [<max area>]'";
+            rows(&mut lx, &mut toks, nr, "regions", 4, usage, |lx, toks| {
                 let point = [lx.tok_f64(toks[1], "x")?, lx.tok_f64(toks[2], "y")?];
                 let a = lx.tok_f64(toks[3], "region label")?;
                 let label = label_of_f64(a).map_err(|e| lx.err(e))?;
@@ -160,7 +170,8 @@ pub fn parse_poly(data: &[u8], file: &str, node: Option<(&[u8], &str)>) -> Resul
                     return Err(lx.err("region label 0 (0 means outside; use a hole instead)"));
                 }
                 g.regions.push(RegionPoint { point, label });
-            }
+                Ok(())
+            })?;
         }
     }
     Ok(PslgRead { pslg: g, files })
