@@ -140,5 +140,5 @@ pub fn write<W: Write>(w: W, mesh: &SurfaceMesh, file: &str) -> Result<()> {
     out.c(b' ');
     out.int(mesh.triangles.len());
     out.s(" 0\n");
-    write_points_and_counted_triangles(out, mesh, file)
+    write_points_and_counted_triangles(out, mesh, file, false)
 }

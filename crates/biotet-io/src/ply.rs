@@ -537,27 +537,5 @@ pub fn write_ascii<W: Write>(w: W, mesh: &SurfaceMesh, file: &str) -> Result<()>
     check_surface(mesh, file)?;
     let mut out = Out::new(w);
     header(&mut out, "ascii", mesh);
-    if !labelled(mesh) {
-        return write_points_and_counted_triangles(out, mesh, file);
-    }
-    for p in &mesh.points {
-        out.f64(p[0]);
-        out.c(b' ');
-        out.f64(p[1]);
-        out.c(b' ');
-        out.f64(p[2]);
-        out.c(b'\n');
-        out.check().map_err(|e| Error::io(file, e))?;
-    }
-    for (t, s) in mesh.triangles.iter().zip(&mesh.sides) {
-        out.c(b'3');
-        for v in t.iter().chain(s) {
-            out.c(b' ');
-            out.int(*v);
-        }
-        out.c(b'\n');
-        out.check().map_err(|e| Error::io(file, e))?;
-    }
-    out.finish().map_err(|e| Error::io(file, e))?;
-    Ok(())
+    write_points_and_counted_triangles(out, mesh, file, labelled(mesh))
 }

@@ -349,11 +349,12 @@ impl<W: Write> Out<W> {
 }
 
 /// The body shared by OFF and ASCII PLY: one `x y z` line per point, then one `3 a b c` line per
-/// triangle; finishes the output.
+/// triangle (followed by its two side labels with `sides`); finishes the output.
 pub(crate) fn write_points_and_counted_triangles<W: Write>(
     mut out: Out<W>,
     mesh: &biotet::SurfaceMesh,
     file: &str,
+    sides: bool,
 ) -> Result<()> {
     for p in &mesh.points {
         out.f64(p[0]);
@@ -364,9 +365,10 @@ pub(crate) fn write_points_and_counted_triangles<W: Write>(
         out.c(b'\n');
         out.check().map_err(|e| Error::io(file, e))?;
     }
-    for t in &mesh.triangles {
+    for (i, t) in mesh.triangles.iter().enumerate() {
         out.c(b'3');
-        for &v in t {
+        let labels = if sides { &mesh.sides[i][..] } else { &[] };
+        for &v in t.iter().chain(labels) {
             out.c(b' ');
             out.int(v);
         }
