@@ -23,7 +23,7 @@ use rustc_hash::FxHashSet;
 
 use crate::geom::predicates::{Sign, in_exact_range, orient3d};
 use crate::geom::vec3::{add, cross, dot, norm2, scale, sub, volume6};
-use crate::lastresort::{SearchOptions, Searcher};
+use crate::lastresort::Searcher;
 use crate::mesh::tet::NO_NEIGHBOR;
 use crate::quality::tet::min_dihedral_chord2;
 
@@ -143,12 +143,7 @@ impl Work {
                 if !every_face_has_candidate(&self.pts, &cav.shell, &cands, floor) {
                     continue;
                 }
-                let so = SearchOptions {
-                    min_quality: 0.0,
-                    min_dihedral: floor,
-                    max_nodes: rp.max_nodes,
-                    improve: Some(rp.improve_nodes),
-                };
+                let so = rp.options(floor);
                 let r = searcher.fill(&self.pts, &cav.shell, &[p], &so);
                 if let Ok(f) = r {
                     let cur = self.cavity(ids);

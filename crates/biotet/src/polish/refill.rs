@@ -25,6 +25,18 @@ pub(super) struct RefillParams {
     pub max_tets: usize,
 }
 
+impl RefillParams {
+    /// The search's options for fills whose every tet is above `floor` degrees.
+    pub fn options(&self, floor: f64) -> SearchOptions {
+        SearchOptions {
+            min_quality: 0.0,
+            min_dihedral: floor,
+            max_nodes: self.max_nodes,
+            improve: Some(self.improve_nodes),
+        }
+    }
+}
+
 /// The unforced worst angle, overall worst angle and count below `thr` of `tets`.
 pub(super) fn judge(w: &mut Work, tets: &[u32], thr: f64) -> (f64, f64, usize) {
     let (mut unforced, mut all, mut below) = (f64::INFINITY, f64::INFINITY, 0);
@@ -135,12 +147,7 @@ impl Work {
             if !every_face_has_candidate(&self.pts, &cav.shell, &cands, floor) {
                 continue;
             }
-            let so = SearchOptions {
-                min_quality: 0.0,
-                min_dihedral: floor,
-                max_nodes: p.max_nodes,
-                improve: Some(p.improve_nodes),
-            };
+            let so = p.options(floor);
             if let Ok(f) = searcher.fill(&self.pts, &cav.shell, &inner, &so) {
                 fill = Some(f);
                 break;
