@@ -1004,27 +1004,30 @@ impl<'a> Recovery<'a> {
             };
         }
         let [u, vv, w] = tp;
-        for t in self.star(v[0]) {
-            if self.tet_mark[t as usize] != st {
-                continue;
-            }
-            let c = self.mesh.corners(t as usize);
-            let inside = TET_FACES.iter().all(|f| {
-                let (a, b, cc) = (c[f[0]], c[f[1]], c[f[2]]);
-                let mut s = orient3d(a, b, cc, u);
-                if s == Sign::Zero {
-                    s = orient3d(a, b, cc, w);
+        // Any carved tet at u holding the symbolic point answers: no order, no allocation.
+        let inside = self.with_star(v[0], |star| {
+            star.iter().any(|&t| {
+                self.tet_mark[t as usize] == st && {
+                    let c = self.mesh.corners(t as usize);
+                    TET_FACES.iter().all(|f| {
+                        let (a, b, cc) = (c[f[0]], c[f[1]], c[f[2]]);
+                        let mut s = orient3d(a, b, cc, u);
+                        if s == Sign::Zero {
+                            s = orient3d(a, b, cc, w);
+                        }
+                        if s == Sign::Zero {
+                            s = orient3d(a, b, cc, vv);
+                        }
+                        s != Sign::Positive
+                    })
                 }
-                if s == Sign::Zero {
-                    s = orient3d(a, b, cc, vv);
-                }
-                s != Sign::Positive
-            });
-            if inside {
-                return Place::Inside;
-            }
+            })
+        });
+        if inside {
+            Place::Inside
+        } else {
+            Place::Outside
         }
-        Place::Outside
     }
 
     /// Split into cells and search each; the new tets in global numbering.
