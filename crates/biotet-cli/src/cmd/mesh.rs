@@ -81,7 +81,8 @@ pub struct Args {
     /// Largest template size in voxels (one byte each).
     #[arg(long, value_name = "N", default_value_t = 1 << 31)]
     max_voxels: usize,
-    /// Skip boundary recovery (LAST RESORT); missing input triangles are only counted.
+    /// Skip boundary recovery (LAST RESORT), and polishing, which needs it; missing input
+    /// triangles are only counted.
     #[arg(long)]
     no_recover: bool,
     /// Skip sliver removal (and the polish, its last pass).
