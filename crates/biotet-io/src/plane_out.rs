@@ -45,19 +45,13 @@ pub fn write_vtu<W: Write>(w: W, mesh: &TriMesh, file: &str) -> Result<()> {
     o.int(mesh.triangles.len());
     o.s("\">\n<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n");
     for p in &mesh.points {
-        o.f64(p[0]);
-        o.c(b' ');
-        o.f64(p[1]);
+        o.f64s(p);
         o.s(" 0\n");
         o.check().map_err(io)?;
     }
     o.s("</DataArray>\n</Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n");
     for t in &mesh.triangles {
-        o.int(t[0]);
-        o.c(b' ');
-        o.int(t[1]);
-        o.c(b' ');
-        o.int(t[2]);
+        o.ints(t);
         o.c(b'\n');
         o.check().map_err(io)?;
     }
@@ -134,9 +128,7 @@ pub fn write_msh<W: Write>(w: W, mesh: &TriMesh, file: &str) -> Result<()> {
     for (i, p) in mesh.points.iter().enumerate() {
         o.int(i + 1);
         o.c(b' ');
-        o.f64(p[0]);
-        o.c(b' ');
-        o.f64(p[1]);
+        o.f64s(p);
         o.s(" 0\n");
         o.check().map_err(io)?;
     }

@@ -280,19 +280,13 @@ pub fn write_poly<W: std::io::Write>(w: W, g: &Pslg, file: &str) -> Result<()> {
     for (i, p) in g.points.iter().enumerate() {
         out.int(i + 1);
         out.c(b' ');
-        out.f64(p[0]);
-        out.c(b' ');
-        out.f64(p[1]);
+        out.f64s(p);
         out.c(b'\n');
     }
     out.int(g.segments.len());
     out.s(" 1\n");
     for (i, s) in g.segments.iter().enumerate() {
-        out.int(i + 1);
-        out.c(b' ');
-        out.int(s[0] + 1);
-        out.c(b' ');
-        out.int(s[1] + 1);
+        out.ints(&[i as i64 + 1, s[0] as i64 + 1, s[1] as i64 + 1]);
         out.c(b' ');
         out.int(g.segment_markers.get(i).copied().unwrap_or(0));
         out.c(b'\n');
@@ -302,9 +296,7 @@ pub fn write_poly<W: std::io::Write>(w: W, g: &Pslg, file: &str) -> Result<()> {
     for (i, p) in g.holes.iter().enumerate() {
         out.int(i + 1);
         out.c(b' ');
-        out.f64(p[0]);
-        out.c(b' ');
-        out.f64(p[1]);
+        out.f64s(p);
         out.c(b'\n');
     }
     out.int(g.regions.len());
@@ -312,9 +304,7 @@ pub fn write_poly<W: std::io::Write>(w: W, g: &Pslg, file: &str) -> Result<()> {
     for (i, r) in g.regions.iter().enumerate() {
         out.int(i + 1);
         out.c(b' ');
-        out.f64(r.point[0]);
-        out.c(b' ');
-        out.f64(r.point[1]);
+        out.f64s(&r.point);
         out.c(b' ');
         out.int(r.label);
         out.c(b'\n');

@@ -311,6 +311,26 @@ impl<W: Write> Out<W> {
         self.buf.extend_from_slice(b.format(x).as_bytes());
     }
 
+    /// Numbers separated by single spaces (no line end).
+    pub fn f64s(&mut self, xs: &[f64]) {
+        for (i, &x) in xs.iter().enumerate() {
+            if i > 0 {
+                self.c(b' ');
+            }
+            self.f64(x);
+        }
+    }
+
+    /// Integers separated by single spaces (no line end).
+    pub fn ints<I: itoa::Integer + Copy>(&mut self, xs: &[I]) {
+        for (i, &x) in xs.iter().enumerate() {
+            if i > 0 {
+                self.c(b' ');
+            }
+            self.int(x);
+        }
+    }
+
     /// Text.
     #[inline]
     pub fn s(&mut self, s: &str) {
@@ -357,11 +377,7 @@ pub(crate) fn write_points_and_counted_triangles<W: Write>(
     sides: bool,
 ) -> Result<()> {
     for p in &mesh.points {
-        out.f64(p[0]);
-        out.c(b' ');
-        out.f64(p[1]);
-        out.c(b' ');
-        out.f64(p[2]);
+        out.f64s(p);
         out.c(b'\n');
         out.check().map_err(|e| Error::io(file, e))?;
     }
