@@ -48,7 +48,7 @@ use crate::geom::filter::orient3d;
 use crate::geom::intersect::{TriTri, is_degenerate, seg_tri, tri_tri};
 use crate::geom::predicates::{Sign, in_exact_range};
 use crate::geom::vec3::{cross, norm, norm2, sub};
-use crate::quality::tet::{min_dihedral_chord2, q_measure};
+use crate::quality::tet::{min_dihedral_chord2, q_measure, volume};
 use rustc_hash::FxHashMap;
 use std::cell::Cell;
 use thiserror::Error;
@@ -191,6 +191,7 @@ struct Face {
 #[derive(Debug, Clone, Copy)]
 struct Cand {
     p: u32,
+    /// q³ ([`q_cubed`]): candidates are ranked and bounded by it.
     q: f64,
     /// [`UNCHECKED`], [`VALID`] or [`DEAD`].
     state: u8,
@@ -237,12 +238,15 @@ pub struct Searcher {
     levels: Vec<Level>,
     worst: Vec<f64>,
     best: Vec<[u32; 4]>,
+    /// The best fill's worst q³, and the bound (q³) candidates must beat.
     best_worst: f64,
     have_best: bool,
     bound: f64,
     nodes: u64,
     budget: u64,
     eta: f64,
+    /// ηe³.
+    eta3: f64,
     /// The dihedral floor as [`min_dihedral_chord2`] of it; `None` for no floor.
     floor: Option<f64>,
     improve: Option<u64>,
@@ -300,6 +304,46 @@ impl Plane {
 fn tri_shape(c: &[P3; 3]) -> f64 {
     let (u, v, w) = (sub(c[1], c[0]), sub(c[2], c[0]), sub(c[2], c[1]));
     norm(cross(u, v)) / (norm2(u) + norm2(v) + norm2(w))
+}
+
+/// q³ (eq. 4.9 cubed): the same order as q without its cube root, for ranking candidates.
+#[inline]
+fn q_cubed(c: &[P3; 4]) -> f64 {
+    let v = volume(c);
+    let l2: f64 = crate::mesh::tet::TET_EDGES
+        .iter()
+        .map(|&[i, j]| norm2(sub(c[i], c[j])))
+        .sum();
+    if l2 == 0.0 {
+        return 0.0;
+    }
+    let w = 3.0 * v;
+    v.signum() * 1728.0 * w * w / (l2 * l2 * l2)
+}
+
+/// Is [`min_dihedral_chord2`] of the tet above `floor`? For a floor below a right angle, on the
+/// unnormalised face normals without a square root: the chord² at the edge of faces k, l is
+/// 2 + 2·cos(n_k, n_l), so it is at most the floor when n_k·n_l ≤ c·|n_k||n_l| with
+/// c = floor/2 − 1 < 0.
+#[inline]
+fn dihedrals_above(c: &[P3; 4], floor: f64) -> bool {
+    let k = 0.5 * floor - 1.0;
+    if k >= 0.0 {
+        return min_dihedral_chord2(c) > floor;
+    }
+    let n = [0, 1, 2, 3].map(|i| {
+        let l = crate::mesh::tet::TET_FACES[i];
+        cross(sub(c[l[1]], c[l[0]]), sub(c[l[2]], c[l[0]]))
+    });
+    let m = n.map(norm2);
+    if m.contains(&0.0) {
+        return false;
+    }
+    let k2 = k * k;
+    crate::mesh::tet::TET_EDGES.iter().all(|&[i, j]| {
+        let d = n[i][0] * n[j][0] + n[i][1] * n[j][1] + n[i][2] * n[j][2];
+        d >= 0.0 || d * d < k2 * m[i] * m[j]
+    })
 }
 
 fn sort3(f: [u32; 3]) -> ([u32; 3], bool) {
@@ -381,8 +425,28 @@ impl Searcher {
         inner: &[u32],
         opts: &SearchOptions,
     ) -> Result<Fill, SearchError> {
-        self.load(points, shell, inner)?;
+        self.load(points, shell, inner, false)?;
+        self.run(opts)
+    }
+
+    /// [`Self::fill`] for a shell carved from a valid mesh: the caller vouches that the points are
+    /// distinct and in range and that the shell is closed, consistently oriented and without
+    /// degenerate triangles, so those checks (a fifth of a small search) run in debug builds only.
+    pub(crate) fn fill_carved(
+        &mut self,
+        points: &[P3],
+        shell: &[[u32; 3]],
+        inner: &[u32],
+        opts: &SearchOptions,
+    ) -> Result<Fill, SearchError> {
+        self.load(points, shell, inner, !cfg!(debug_assertions))?;
+        self.run(opts)
+    }
+
+    /// The search proper, on a loaded shell.
+    fn run(&mut self, opts: &SearchOptions) -> Result<Fill, SearchError> {
         self.eta = opts.min_quality;
+        self.eta3 = opts.min_quality.powi(3);
         self.floor = (opts.min_dihedral > 0.0).then(|| {
             let s = (opts.min_dihedral.to_radians() / 2.0).sin();
             4.0 * s * s
@@ -424,9 +488,15 @@ impl Searcher {
                 .iter()
                 .map(|t| t.map(|v| self.global[v as usize]))
                 .collect();
+            // q itself, exactly as `q_measure` gives it (the search ranked by q³).
+            let worst_q = self
+                .best
+                .iter()
+                .map(|t| q_measure(&t.map(|v| self.pts[v as usize])))
+                .fold(f64::INFINITY, f64::min);
             return Ok(Fill {
                 tets,
-                worst_q: self.best_worst,
+                worst_q,
                 nodes_visited: self.nodes,
                 optimal: flow == Flow::Continue,
             });
@@ -441,12 +511,13 @@ impl Searcher {
         }
     }
 
-    /// Validate the input and set up local points and the initial front.
+    /// Validate the input (unless `trusted`) and set up local points and the initial front.
     fn load(
         &mut self,
         points: &[P3],
         shell: &[[u32; 3]],
         inner: &[u32],
+        trusted: bool,
     ) -> Result<(), SearchError> {
         if shell.is_empty() {
             return Err(SearchError::Empty);
@@ -464,54 +535,18 @@ impl Searcher {
         self.pts.clear();
         for &g in &self.global {
             let p = points[g as usize];
-            if !p.iter().all(|&c| in_exact_range(c)) {
+            if !trusted && !p.iter().all(|&c| in_exact_range(c)) {
                 return Err(SearchError::BadCoordinate { index: g });
             }
             self.pts.push(p);
         }
-        // Duplicates: sort local ids by coordinates.
-        let order = &mut self.order;
-        order.clear();
-        order.extend(0..self.pts.len() as u32);
-        let key = crate::mesh::coord_key;
-        order.sort_unstable_by_key(|&i| key(&self.pts[i as usize]));
-        for w in self.order.windows(2) {
-            if key(&self.pts[w[0] as usize]) == key(&self.pts[w[1] as usize]) {
-                return Err(SearchError::DuplicatePoint {
-                    a: self.global[w[0] as usize],
-                    b: self.global[w[1] as usize],
-                });
-            }
-        }
         let local = |g: u32, global: &[u32]| global.binary_search(&g).unwrap_or(0) as u32;
         self.scratch.clear();
-        for (i, f) in shell.iter().enumerate() {
-            let l = f.map(|g| local(g, &self.global));
-            let c = l.map(|v| self.pts[v as usize]);
-            if l[0] == l[1] || l[1] == l[2] || l[0] == l[2] || is_degenerate(&c) {
-                return Err(SearchError::DegenerateFace { face: i });
-            }
-            self.scratch.push(l);
-        }
-        // Closed: every directed edge matched by its reverse.
-        self.edges.clear();
-        for f in &self.scratch {
-            for k in 0..3 {
-                self.edges.push((f[k], f[(k + 1) % 3]));
-            }
-        }
-        self.edges.sort_unstable();
-        let count = |e: &[(u32, u32)], x: (u32, u32)| {
-            let lo = e.partition_point(|y| *y < x);
-            e[lo..].iter().take_while(|y| **y == x).count()
-        };
-        for &(a, b) in &self.edges {
-            if count(&self.edges, (a, b)) != count(&self.edges, (b, a)) {
-                return Err(SearchError::NotClosed {
-                    a: self.global[a as usize],
-                    b: self.global[b as usize],
-                });
-            }
+        if trusted {
+            self.scratch
+                .extend(shell.iter().map(|f| f.map(|g| local(g, &self.global))));
+        } else {
+            self.check(shell)?;
         }
         let np = self.pts.len();
         self.front_deg.clear();
@@ -541,6 +576,55 @@ impl Searcher {
             self.push_face(f);
         }
         self.scratch = scratch;
+        Ok(())
+    }
+
+    /// The checks [`Self::fill_carved`] skips: distinct points, non-degenerate shell triangles
+    /// (mapped to local ids into `scratch`), a closed consistently oriented shell.
+    fn check(&mut self, shell: &[[u32; 3]]) -> Result<(), SearchError> {
+        // Duplicates: sort local ids by coordinates.
+        let order = &mut self.order;
+        order.clear();
+        order.extend(0..self.pts.len() as u32);
+        let key = crate::mesh::coord_key;
+        order.sort_unstable_by_key(|&i| key(&self.pts[i as usize]));
+        for w in self.order.windows(2) {
+            if key(&self.pts[w[0] as usize]) == key(&self.pts[w[1] as usize]) {
+                return Err(SearchError::DuplicatePoint {
+                    a: self.global[w[0] as usize],
+                    b: self.global[w[1] as usize],
+                });
+            }
+        }
+        let local = |g: u32, global: &[u32]| global.binary_search(&g).unwrap_or(0) as u32;
+        for (i, f) in shell.iter().enumerate() {
+            let l = f.map(|g| local(g, &self.global));
+            let c = l.map(|v| self.pts[v as usize]);
+            if l[0] == l[1] || l[1] == l[2] || l[0] == l[2] || is_degenerate(&c) {
+                return Err(SearchError::DegenerateFace { face: i });
+            }
+            self.scratch.push(l);
+        }
+        // Closed: every directed edge matched by its reverse.
+        self.edges.clear();
+        for f in &self.scratch {
+            for k in 0..3 {
+                self.edges.push((f[k], f[(k + 1) % 3]));
+            }
+        }
+        self.edges.sort_unstable();
+        let count = |e: &[(u32, u32)], x: (u32, u32)| {
+            let lo = e.partition_point(|y| *y < x);
+            e[lo..].iter().take_while(|y| **y == x).count()
+        };
+        for &(a, b) in &self.edges {
+            if count(&self.edges, (a, b)) != count(&self.edges, (b, a)) {
+                return Err(SearchError::NotClosed {
+                    a: self.global[a as usize],
+                    b: self.global[b as usize],
+                });
+            }
+        }
         Ok(())
     }
 
@@ -804,12 +888,10 @@ impl Searcher {
             }
             let d = self.pts[p as usize];
             let corners = [a, b, c, d];
-            let q = q_measure(&corners);
-            if (self.eta > 0.0 && q.partial_cmp(&self.eta) != Some(std::cmp::Ordering::Greater))
+            let q = q_cubed(&corners);
+            if (self.eta > 0.0 && !self.above_eta(q, &corners))
                 || q <= self.bound
-                || self
-                    .floor
-                    .is_some_and(|f| min_dihedral_chord2(&corners) <= f)
+                || self.floor.is_some_and(|f| !dihedrals_above(&corners, f))
             {
                 continue;
             }
@@ -828,6 +910,19 @@ impl Searcher {
         face.c1 = self.cands.len() as u32;
         face.live = face.c1 - face.c0;
         face.valid = 0;
+    }
+
+    /// Is the tet's q strictly above ηe? Decided on q³ unless the two are too close to call,
+    /// then on q itself, so the threshold means what [`SearchOptions::min_quality`] says.
+    #[inline]
+    fn above_eta(&self, q3: f64, corners: &[P3; 4]) -> bool {
+        if q3 > self.eta3 * (1.0 + 1e-9) {
+            return true;
+        }
+        if q3 < self.eta3 * (1.0 - 1e-9) {
+            return false;
+        }
+        q_measure(corners).partial_cmp(&self.eta) == Some(std::cmp::Ordering::Greater)
     }
 
     /// Check conditions 3–4 of candidate `k` of face `f` against the current front; records
