@@ -221,8 +221,8 @@ struct Work<'a> {
     claim: Vec<u32>,
     /// The pending batch's id.
     batch_id: u32,
-    /// Per tet: its metric and q (NaN until computed).
-    cache: Vec<[f64; 2]>,
+    /// Per tet: its metric (NaN until computed).
+    cache: Vec<f64>,
     vtet: Vec<u32>,
     /// Per tet: the stamp of the last star walk that met it (see [`Work::star`]).
     star_mark: Vec<u32>,
@@ -426,20 +426,15 @@ impl<'a> Work<'a> {
         self.tets[t as usize].map(|v| self.pts[v as usize])
     }
 
-    /// The metric and q of tet `t`, computed once per tet (a tet's corners never change).
-    fn measures(&mut self, t: u32) -> [f64; 2] {
+    /// The metric of tet `t`, computed once per tet (a tet's corners never change).
+    fn value(&mut self, t: u32) -> f64 {
         let m = self.cache[t as usize];
-        if !m[0].is_nan() {
+        if !m.is_nan() {
             return m;
         }
-        let c = self.corners(t);
-        let m = [measure(&c, self.opts.metric), q_measure(&c)];
+        let m = measure(&self.corners(t), self.opts.metric);
         self.cache[t as usize] = m;
         m
-    }
-
-    fn value(&mut self, t: u32) -> f64 {
-        self.measures(t)[0]
     }
 
     /// Every live tet with corner `v` (walking across the faces around `v`), appended to `out`.
@@ -553,7 +548,7 @@ impl<'a> Work<'a> {
                 Some(t) => {
                     self.forced[t as usize] = 0;
                     self.local_tried[t as usize] = false;
-                    self.cache[t as usize] = [f64::NAN; 2];
+                    self.cache[t as usize] = f64::NAN;
                     self.tets[t as usize] = *tv;
                     self.nb[t as usize] = [NO_NEIGHBOR; 4];
                     self.labels[t as usize] = label;
@@ -569,7 +564,7 @@ impl<'a> Work<'a> {
                     self.rounds.push(rounds);
                     self.forced.push(0);
                     self.local_tried.push(false);
-                    self.cache.push([f64::NAN; 2]);
+                    self.cache.push(f64::NAN);
                     (self.tets.len() - 1) as u32
                 }
             };
@@ -921,7 +916,13 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
             }
         }
     }
-    w.cache = vec![[f64::NAN; 2]; n];
+    // Every tet's metric, on all threads (the same values in any order).
+    let (pts, metric) = (w.pts, opts.metric);
+    w.cache = w
+        .tets
+        .par_iter()
+        .map(|t| measure(&t.map(|v| pts[v as usize]), metric))
+        .collect();
     w.report.n_tets_before = n;
     for t in 0..n {
         for &v in &w.tets[t] {
@@ -1017,7 +1018,7 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     labels.shrink_to_fit();
     let pts = &mesh.points;
     let bad_after = tets
-        .iter()
+        .par_iter()
         .filter(|t| measure(&t.map(|v| pts[v as usize]), opts.metric) < opts.threshold)
         .count();
     let mut report = std::mem::take(&mut w.report);
