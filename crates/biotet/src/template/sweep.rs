@@ -14,6 +14,9 @@ use super::voxels::{INTERIOR_NODE, QUEUED, Template, UNPROCESSED, Zone};
 pub fn sweep(t: &mut Template, zone: Zone, radius: &dyn Fn([f64; 3], u32) -> usize) -> usize {
     let [nx, ny, nz] = t.n;
     let mut front: VecDeque<u32> = VecDeque::new();
+    // Whether an inside voxel lies on the grid's border (only with a zero margin): else every
+    // inside voxel has all six neighbours, found by index steps without its (i, j, k).
+    let mut on_border = false;
     // Seeds: inside voxels already claimed by the boundary buffer, or touching the outside.
     for k in 0..nz {
         for j in 0..ny {
@@ -23,6 +26,8 @@ pub fn sweep(t: &mut Template, zone: Zone, radius: &dyn Fn([f64; 3], u32) -> usi
                 if t.region(idx) == 0 {
                     continue;
                 }
+                on_border |=
+                    i == 0 || j == 0 || k == 0 || i + 1 == nx || j + 1 == ny || k + 1 == nz;
                 let seed = t.state(idx) != UNPROCESSED
                     || neighbours(t, i, j, k, idx).any(|m| t.region(m) == 0);
                 if seed {
@@ -33,18 +38,25 @@ pub fn sweep(t: &mut Template, zone: Zone, radius: &dyn Fn([f64; 3], u32) -> usi
         }
     }
     let mut placed = 0;
+    let (sy, sz) = (nx, nx * ny);
     while let Some(idx) = front.pop_front() {
         let idx = idx as usize;
-        let [i, j, k] = t.ijk(idx);
         if t.state(idx) == UNPROCESSED {
+            let c = t.ijk(idx);
             t.set_state(idx, INTERIOR_NODE);
             placed += 1;
-            let r = radius(t.point([i, j, k]), t.region(idx));
-            t.mark_zone([i, j, k], r, zone);
+            let r = radius(t.point(c), t.region(idx));
+            t.mark_zone(c, r, zone);
         }
+        // The same six neighbours in the same order either way.
         let mut next = [usize::MAX; 6];
-        for (s, m) in neighbours(t, i, j, k, idx).enumerate() {
-            next[s] = m;
+        if on_border {
+            let [i, j, k] = t.ijk(idx);
+            for (s, m) in neighbours(t, i, j, k, idx).enumerate() {
+                next[s] = m;
+            }
+        } else {
+            next = [idx - 1, idx + 1, idx - sy, idx + sy, idx - sz, idx + sz];
         }
         for m in next {
             if m != usize::MAX && t.region(m) != 0 && t.cells[m] & QUEUED == 0 {
