@@ -329,6 +329,18 @@ struct Tried {
     out: Option<Outcome>,
 }
 
+/// A worker's reusable buffers: kept per thread across batches, so that a search does not
+/// start from empty buffers each time rayon splits a batch.
+#[derive(Default)]
+struct WorkerScratch {
+    searcher: Searcher,
+    mark: FxHashSet<u32>,
+}
+
+thread_local! {
+    static SCRATCH: std::cell::RefCell<WorkerScratch> = std::cell::RefCell::default();
+}
+
 /// The mesh as the workers read it while a batch is searched (nothing changes meanwhile).
 struct View<'b> {
     pts: &'b [P3],
@@ -394,11 +406,11 @@ impl View<'_> {
 
     /// The moves of a [`Task`], run on any thread, until one is accepted. The grown cavity is
     /// skipped when the seed's cavity failed at its search's root (see [`step`]).
-    fn run_task(&self, searcher: &mut Searcher, task: &Task) -> Vec<Tried> {
-        let mut mark = FxHashSet::default();
+    fn run_task(&self, ws: &mut WorkerScratch, task: &Task) -> Vec<Tried> {
+        let WorkerScratch { searcher, mark } = ws;
         let mut done = Vec::with_capacity(task.tries.len());
         for (kind, tets) in &task.tries {
-            let cav = self.cavity(tets.clone(), &mut mark);
+            let cav = self.cavity(tets.clone(), mark);
             let plan = self.plan(&cav);
             let out = plan
                 .as_ref()
@@ -836,10 +848,26 @@ fn run_batch(w: &mut Work, batch: &mut Vec<Task>) {
         nb: &w.nb,
         opts: w.opts,
     };
-    let results: Vec<Vec<Tried>> = batch
-        .par_iter()
-        .map_init(Searcher::new, |s, task| view.run_task(s, task))
+    // Largest tasks first, one task per job: the batch's tail is then made of small tasks, not
+    // of one long search with the other thread idle. Results go back in batch order.
+    let mut order: Vec<(usize, usize)> = batch
+        .iter()
+        .enumerate()
+        .map(|(i, t)| (t.tries.iter().map(|(_, c)| c.len() * c.len()).sum(), i))
         .collect();
+    order.sort_unstable_by(|a, b| b.cmp(a));
+    let mut found: Vec<(usize, Vec<Tried>)> = order
+        .par_iter()
+        .with_max_len(1)
+        .map(|&(_, i)| {
+            (
+                i,
+                SCRATCH.with_borrow_mut(|ws| view.run_task(ws, &batch[i])),
+            )
+        })
+        .collect();
+    found.sort_unstable_by_key(|x| x.0);
+    let results: Vec<Vec<Tried>> = found.into_iter().map(|x| x.1).collect();
     for (task, tried) in batch.drain(..).zip(results) {
         let mut fixed = false;
         for t in &tried {
