@@ -951,6 +951,13 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
         .par_iter()
         .map(|t| measure(&t.map(|v| pts[v as usize]), metric))
         .collect();
+    // Which tets the input forces poor, on all threads: the queue's first pass asks it of most
+    // tets near the boundary.
+    let forced: Vec<u8> = (0..n as u32)
+        .into_par_iter()
+        .map(|t| if w.compute_forced(t) { 1 } else { 2 })
+        .collect();
+    w.forced = forced;
     w.report.n_tets_before = n;
     for t in 0..n {
         for &v in &w.tets[t] {
