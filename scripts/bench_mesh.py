@@ -39,8 +39,14 @@ def run_biotet(surface, out, extra, repeat):
         j = biotet_json("mesh", surface, "-o", out, *extra)
         wall = time.perf_counter() - start
         rows.append({"seconds": j["pipeline"]["seconds_total"], "wall": wall,
-                     "mem_kb": j["peak_rss_kb"] - j["rss_before_kb"], "mesh_bytes": j["mesh_bytes"]})
+                     "mem_kb": j["peak_rss_kb"] - j["rss_before_kb"], "mesh_bytes": j["mesh_bytes"],
+                     "stages": {st["name"]: st["seconds"] for st in j["pipeline"].get("stages", [])}})
     return rows
+
+
+def stage_medians(rows):
+    names = list(rows[0]["stages"])
+    return {n: med([{"s": r["stages"][n]} for r in rows], "s") for n in names}
 
 
 def run_pip_tetgen(surface, switches, base, repeat):
@@ -100,7 +106,8 @@ def main():
             out = os.path.join(tmp, "biotet.vtu")
             rows = run_biotet(s, out, [], a.repeat)
             r = {"surface": name, "tool": "biotet mesh", "seconds": med(rows, "seconds"), "wall": med(rows, "wall"),
-                 "mem_mb": med(rows, "mem_kb") / 1024, "mesh_mb": rows[0]["mesh_bytes"] / 2**20, **measure(out, s)}
+                 "mem_mb": med(rows, "mem_kb") / 1024, "mesh_mb": rows[0]["mesh_bytes"] / 2**20,
+                 "stages": stage_medians(rows), **measure(out, s)}
             results.append(r)
             base = os.path.join(tmp, "pip_tetgen")
             rows, err = run_pip_tetgen(s, a.switches, base, a.repeat)
@@ -125,6 +132,10 @@ def main():
                   f"| {fmt(r['mem_mb'], '.1f')} | {r['points']} | {r['tets']} | {fmt(r['min_dihedral'], '.4f')} "
                   f"| {fmt(r['max_dihedral'], '.2f')} | {fmt(r['mean_q'], '.3f')} | {r['lt5']} | {r['lt10']} "
                   f"| {r['lt20']} | {r['missing']} | {r['valid']} |")
+        for r in results:
+            if r.get("stages"):
+                st = ", ".join(f"{n} {v:.3f}" for n, v in r["stages"].items())
+                print(f"\n{r['surface']}: biotet stage seconds (medians): {st}")
         if results and results[0].get("mesh_mb"):
             r = results[0]
             print(f"\nbiotet: peak memory {r['mem_mb']:.1f} MB for an output mesh of {r['mesh_mb']:.1f} MB in memory "
