@@ -19,7 +19,8 @@ use crate::error::{Error, Result};
 /// The writer handed to format writers: a large buffer over the temporary file.
 pub type AtomicWriter = BufWriter<NamedTempFile>;
 
-const BUF: usize = 1 << 20;
+// Large enough that writes are few, small beside the mesh being written.
+const BUF: usize = 1 << 18;
 
 fn temp_for(path: &Path) -> Result<NamedTempFile> {
     let name = path.display().to_string();

@@ -2,6 +2,7 @@
 //! ([`crate::delaunay`]), keep the tets inside the surface, then the later stages. This module
 //! only strings the stages together, times them and counts what they did.
 
+use std::borrow::Borrow;
 use std::time::Instant;
 
 use rayon::prelude::*;
@@ -132,10 +133,11 @@ pub enum PipelineError {
 ///
 /// The output's first points are the surface's points (same indices), then the interior nodes;
 /// tets carry the label of the region containing them. `progress` hears each stage's name as it
-/// starts.
-pub fn mesh_surface(
+/// starts. The sizing is used by node deployment only: passed by value (rather than as
+/// `&Sizing`), it is freed once the nodes are placed, before the later stages' peaks.
+pub fn mesh_surface<S: Borrow<Sizing>>(
     surface: &SurfaceMesh,
-    sizing: &Sizing,
+    sizing: S,
     opts: &PipelineOptions,
     progress: &mut dyn FnMut(&str),
 ) -> Result<(TetMesh, MeshReport), PipelineError> {
@@ -150,7 +152,8 @@ pub fn mesh_surface(
 
     progress("deploying nodes");
     let clock = Instant::now();
-    let dep = deploy(surface, sizing, &opts.deploy)?;
+    let dep = deploy(surface, sizing.borrow(), &opts.deploy)?;
+    drop(sizing);
     report.template = dep.stats.clone();
     report.n_surface_points = dep.n_surface;
     report.n_interior_nodes = dep.interior_regions.len();
@@ -177,79 +180,66 @@ pub fn mesh_surface(
         }
     }
     let ns = dep.n_surface as u32;
-    let locator = RegionLocator::new(surface);
-    // Which slots are kept, as a bitset with a rank per word: the kept tets' neighbours come
-    // from the triangulation's own adjacency (no face sorting, no per-slot index array).
-    let mut kept = vec![0u64; del.n_slots().div_ceil(64)];
-    let mut tets = Vec::with_capacity(del.n_finite_tets());
-    let mut labels = Vec::with_capacity(del.n_finite_tets());
-    // Tets with two or more surface corners need a centroid test: those are found on all
-    // threads, a chunk at a time (bounded scratch), and taken in order.
-    let mut all = del.finite_tets();
-    let mut chunk = Vec::with_capacity(CENTROID_CHUNK);
-    loop {
-        chunk.clear();
-        chunk.extend(all.by_ref().take(CENTROID_CHUNK));
-        if chunk.is_empty() {
-            break;
-        }
-        let found: Vec<([u32; 4], u32)> = chunk
-            .par_iter()
-            .map_init(Transitions::default, |scratch, &t| {
-                let v = del.tet(t).map(|x| input_of[x as usize]);
-                let on_surface = v.iter().filter(|&&x| x < ns).count();
-                let label = if on_surface >= 2 {
-                    centroid_region(del.tet_points(t), &locator, scratch)
-                } else {
-                    let i = v.iter().find(|&&x| x >= ns).copied().unwrap_or(0);
-                    dep.interior_regions[(i - ns) as usize]
-                };
-                (v, label)
-            })
-            .collect();
-        for (&t, (v, label)) in chunk.iter().zip(found) {
-            if v.iter().filter(|&&x| x < ns).count() >= 2 {
-                report.n_centroid_tests += 1;
-            }
-            // With recovery to follow, every tet is kept: recovery works on the convex hull and
-            // labels by flood fill across the recovered surface; the centroid labels stay only
-            // where it cannot (triangles left unrecovered).
-            if label != 0 || opts.recover.is_some() {
-                kept[t as usize / 64] |= 1 << (t % 64);
-                tets.push(v);
-                labels.push(label);
-            }
-        }
+    // The finite slots as a bitset with a rank per word: the tets' neighbours come from the
+    // triangulation's own adjacency (no face sorting, no per-slot index array).
+    let mut finite = vec![0u64; del.n_slots().div_ceil(64)];
+    for t in del.finite_tets() {
+        finite[t as usize / 64] |= 1 << (t % 64);
     }
-    drop(all);
-    let mut rank = Vec::with_capacity(kept.len());
+    let mut rank = Vec::with_capacity(finite.len());
     let mut r = 0u32;
-    for w in &kept {
+    for w in &finite {
         rank.push(r);
         r += w.count_ones();
     }
     let index_of = |t: u32| {
         let (w, b) = (t as usize / 64, t % 64);
-        if kept[w] >> b & 1 == 0 {
+        if finite[w] >> b & 1 == 0 {
             NO_NEIGHBOR
         } else {
-            rank[w] + (kept[w] & ((1u64 << b) - 1)).count_ones()
+            rank[w] + (finite[w] & ((1u64 << b) - 1)).count_ones()
         }
     };
-    // Exact capacity: collecting the filter would double its way up, to 2× in the worst case.
-    let mut neighbors: Vec<[u32; 4]> = Vec::with_capacity(tets.len());
-    neighbors.extend(
-        del.finite_tets()
-            .filter(|&t| kept[t as usize / 64] >> (t % 64) & 1 == 1)
-            .map(|t| del.adjacent(t).map(index_of)),
-    );
-    drop((kept, rank, input_of, locator));
+    // Every finite tet and its neighbours, at exact capacity; the labels wait until the
+    // triangulation, the largest thing held here, is gone.
+    let mut tets: Vec<[u32; 4]> = Vec::with_capacity(report.n_delaunay_tets);
+    let mut neighbors: Vec<[u32; 4]> = Vec::with_capacity(report.n_delaunay_tets);
+    for t in del.finite_tets() {
+        tets.push(del.tet(t).map(|x| input_of[x as usize]));
+        neighbors.push(del.adjacent(t).map(index_of));
+    }
+    drop((finite, rank, input_of));
     let mut points = del.into_vertex_points();
     if points.len() != n_points {
         // Repeated input points share a vertex: give every input index its coordinates back.
         points = (0..n_points).map(|i| points[map[i] as usize]).collect();
     }
-    drop((map, dep.interior_regions));
+    drop(map);
+    // Labels: tets with two or more surface corners by a centroid test, the others by their
+    // interior node's region (on all threads; the order, and so the result, is fixed).
+    let locator = RegionLocator::new(surface);
+    let mut labels: Vec<u32> = Vec::new();
+    tets.par_iter()
+        .map_init(Transitions::default, |scratch, v| {
+            if v.iter().filter(|&&x| x < ns).count() >= 2 {
+                centroid_region(v.map(|x| points[x as usize]), &locator, scratch)
+            } else {
+                let i = v.iter().find(|&&x| x >= ns).copied().unwrap_or(0);
+                dep.interior_regions[(i - ns) as usize]
+            }
+        })
+        .collect_into_vec(&mut labels);
+    report.n_centroid_tests = tets
+        .iter()
+        .filter(|v| v.iter().filter(|&&x| x < ns).count() >= 2)
+        .count();
+    drop((locator, dep.interior_regions));
+    // With recovery to follow, every tet is kept: recovery works on the convex hull and labels
+    // by flood fill across the recovered surface; the centroid labels stay only where it cannot
+    // (triangles left unrecovered). Without it, the outside tets go here.
+    if opts.recover.is_none() {
+        keep_labelled(&mut tets, &mut neighbors, &mut labels);
+    }
     let mut mesh = compact(points, tets, neighbors, labels);
     stage(&mut report, "keep inside", clock);
 
@@ -294,9 +284,6 @@ pub fn mesh_surface(
     Ok((mesh, report))
 }
 
-/// Tets per parallel chunk of the inside test.
-const CENTROID_CHUNK: usize = 1 << 16;
-
 /// Region of a tet by its centroid; if the centroid lies exactly on the surface, other interior
 /// points of the tet decide.
 fn centroid_region(c: [[f64; 3]; 4], locator: &RegionLocator, scratch: &mut Transitions) -> u32 {
@@ -315,29 +302,66 @@ fn centroid_region(c: [[f64; 3]; 4], locator: &RegionLocator, scratch: &mut Tran
     0
 }
 
+/// Drop the tets labelled 0 (outside), in place, keeping the others' order; their neighbours
+/// there become [`NO_NEIGHBOR`].
+fn keep_labelled(tets: &mut Vec<[u32; 4]>, neighbors: &mut Vec<[u32; 4]>, labels: &mut Vec<u32>) {
+    let mut new_index = vec![NO_NEIGHBOR; tets.len()];
+    let mut k = 0u32;
+    for (slot, &l) in new_index.iter_mut().zip(labels.iter()) {
+        if l != 0 {
+            *slot = k;
+            k += 1;
+        }
+    }
+    // New index <= old index: moving down never overwrites a tet still to be moved.
+    for t in 0..tets.len() {
+        let new = new_index[t];
+        if new == NO_NEIGHBOR {
+            continue;
+        }
+        let nb = neighbors[t].map(|n| {
+            if n == NO_NEIGHBOR {
+                n
+            } else {
+                new_index[n as usize]
+            }
+        });
+        let new = new as usize;
+        tets[new] = tets[t];
+        neighbors[new] = nb;
+        labels[new] = labels[t];
+    }
+    let k = k as usize;
+    tets.truncate(k);
+    neighbors.truncate(k);
+    labels.truncate(k);
+}
+
 /// Assemble the mesh, dropping points no tet uses (the others keep their order, surface points
-/// first).
+/// first). In place: after recovery this runs on top of that stage's peak.
 fn compact(
-    points: Vec<[f64; 3]>,
+    mut points: Vec<[f64; 3]>,
     mut tets: Vec<[u32; 4]>,
     neighbors: Vec<[u32; 4]>,
     labels: Vec<u32>,
 ) -> TetMesh {
-    let mut used = vec![false; points.len()];
+    // Used points' new indices (u32::MAX for the unused).
+    let mut new_index = vec![u32::MAX; points.len()];
     for t in &tets {
         for &v in t {
-            used[v as usize] = true;
+            new_index[v as usize] = 0;
         }
     }
-    let mut new_index = vec![u32::MAX; points.len()];
-    let mut kept = Vec::with_capacity(points.len());
-    for (i, p) in points.into_iter().enumerate() {
-        if used[i] {
-            new_index[i] = kept.len() as u32;
-            kept.push(p);
+    let mut k = 0;
+    for i in 0..points.len() {
+        if new_index[i] != u32::MAX {
+            new_index[i] = k as u32;
+            points[k] = points[i];
+            k += 1;
         }
     }
-    if kept.len() != new_index.len() {
+    if k != points.len() {
+        points.truncate(k);
         for t in &mut tets {
             for v in t.iter_mut() {
                 *v = new_index[*v as usize];
@@ -345,12 +369,13 @@ fn compact(
         }
     }
     let mut mesh = TetMesh {
-        points: kept,
+        points,
         tets,
         neighbors,
         labels,
     };
     // Recovery truncates the arrays in place: give the slack back for the later stages.
+    mesh.points.shrink_to_fit();
     mesh.tets.shrink_to_fit();
     mesh.neighbors.shrink_to_fit();
     mesh.labels.shrink_to_fit();

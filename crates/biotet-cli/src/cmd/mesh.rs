@@ -1,6 +1,6 @@
 //! `biotet mesh`: surface in, volume mesh out (the whole pipeline).
 
-use crate::memory::release_free_memory;
+use crate::memory::{StagePeaks, map_mesh_sized_blocks, release_free_memory};
 use crate::{Common, plot, progress::Stage};
 use anyhow::{Context, Result, bail};
 use biotet::mesh::shells::Part;
@@ -167,9 +167,11 @@ pub fn run(a: Args) -> Result<ExitCode> {
         super::input::labelled_surface(&a.surfaces, &a.label, a.common, &stage)?
     };
     let seconds_read = clock.elapsed().as_secs_f64();
-    // Restart the peak-memory count so it measures meshing, not reading and validating (Linux).
-    let _ = std::fs::write("/proc/self/clear_refs", "5");
+    // Restart the peak-memory count so it measures meshing, not reading and validating (Linux),
+    // and keep one peak per stage.
+    let mut peaks = StagePeaks::start("sizing");
     let (_, rss_before_kb) = super::delaunay::memory_kb();
+    map_mesh_sized_blocks();
 
     let spec = match (a.size, &a.size_field) {
         (Some(h), _) => SizeSpec::Uniform(h),
@@ -220,14 +222,17 @@ pub fn run(a: Args) -> Result<ExitCode> {
     if a.no_polish || a.no_improve {
         opts.polish = None;
     }
-    // Each stage starts from what the previous ones left in use, not from their peaks.
-    let (mesh, report) = mesh_surface(&surface, &sizing, &opts, &mut |s| {
+    // Each stage starts from what the previous ones left in use, not from their peaks. The sizing
+    // goes in by value, to be freed after deployment.
+    let (mesh, report) = mesh_surface(&surface, sizing, &opts, &mut |s| {
         release_free_memory();
+        peaks.next(Some(s));
         stage.set(s)
     })
     .with_context(|| name.clone())?;
 
     release_free_memory();
+    peaks.next(Some("measuring"));
     stage.set("measuring");
     let quality = QualityReport::of(&mesh);
     let forcing = {
@@ -235,17 +240,21 @@ pub fn run(a: Args) -> Result<ExitCode> {
         forced::summarise(&mesh, &f, FORCED_DEG)
     };
     // The peak of meshing alone, before the writer builds its arrays.
-    let (peak_meshing_kb, _) = super::delaunay::memory_kb();
+    peaks.next(None);
+    let peak_meshing_kb = peaks.max();
     if let Some(out) = &a.output {
         release_free_memory();
+        peaks.next(Some("writing"));
         stage.set(format!("writing {}", out.display()));
         biotet_io::write_tet_mesh(out, &mesh)?;
     }
     drop(stage);
     if let Some(svg) = &a.svg {
+        peaks.next(Some("plotting"));
         plot::write_quality_svg(&quality, svg, &name)?;
     }
-    let (peak_kb, _) = super::delaunay::memory_kb();
+    peaks.next(None);
+    let peak_kb = peaks.max();
     if a.common.json {
         crate::emit(&serde_json::to_string_pretty(&json!({
             "input": name,
@@ -259,6 +268,11 @@ pub fn run(a: Args) -> Result<ExitCode> {
             "rss_before_kb": rss_before_kb,
             "peak_rss_kb": peak_kb,
             "peak_rss_meshing_kb": peak_meshing_kb,
+            "stage_peak_rss_kb": peaks
+                .peaks
+                .iter()
+                .map(|(stage, kb)| json!({"stage": stage, "peak_rss_kb": kb}))
+                .collect::<Vec<_>>(),
             "mesh_bytes": mesh.bytes(),
         }))?);
     } else if !a.common.quiet {

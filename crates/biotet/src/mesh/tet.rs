@@ -64,7 +64,8 @@ impl TetMesh {
         self.points.len()
     }
 
-    /// Bytes of the mesh's arrays (lengths, not capacities): 24 per point, 36 per tet.
+    /// Bytes of the mesh's arrays by length (not capacity): 24 per point (coordinates), 36 per
+    /// tet (corners 16, face neighbours 16, label 4).
     pub fn bytes(&self) -> usize {
         use std::mem::size_of_val;
         size_of_val(&self.points[..])

@@ -11,11 +11,10 @@
 //! Quality reports split forced from unforced tets: the unforced ones are what a mesher can fix.
 //! Surface triangles are matched to mesh faces by exact point coordinates.
 
-use rustc_hash::FxHashMap;
 use serde::Serialize;
 
 use crate::geom::vec3::{cross, dot, norm, sub};
-use crate::mesh::coord_key;
+use crate::mesh::match_points;
 use crate::mesh::surface::SurfaceMesh;
 use crate::mesh::tet::{TET_EDGES, TET_FACES, TetMesh};
 use crate::quality::tet::{TetMeasures, dihedral_angles};
@@ -78,30 +77,26 @@ fn sorted3(mut a: [u32; 3]) -> [u32; 3] {
 /// Classify every tet of `mesh` against `surface` with the angle `threshold_deg`.
 pub fn classify(mesh: &TetMesh, surface: &SurfaceMesh, threshold_deg: f64) -> Forcing {
     // Mesh point -> surface point.
-    let mut index: FxHashMap<[u64; 3], u32> = Default::default();
-    for (i, p) in surface.points.iter().enumerate() {
-        index.insert(coord_key(p), i as u32);
-    }
-    let surf_of: Vec<u32> = mesh
-        .points
-        .iter()
-        .map(|p| index.get(&coord_key(p)).copied().unwrap_or(u32::MAX))
+    let surf_of = match_points(&mesh.points, &surface.points);
+    // Input triangles and half-edges as indices sorted by their vertex sets: 4 bytes each, where
+    // hash maps (with a list per edge) took several times the mesh's size on brain_20k.
+    let tri_key = |t: u32| sorted3(surface.triangles[t as usize]);
+    let mut triangles: Vec<u32> = (0..surface.triangles.len() as u32).collect();
+    triangles.sort_unstable_by(|&a, &b| tri_key(a).cmp(&tri_key(b)).then(a.cmp(&b)));
+    let poor: Vec<bool> = (0..surface.triangles.len())
+        .map(|t| min_angle_3d_deg(&surface.corners(t)) < threshold_deg)
         .collect();
-    // Input triangles (sorted surface ids) -> poor?
-    let mut triangles: FxHashMap<[u32; 3], bool> = Default::default();
-    // Input edges -> (triangle, opposite vertex) per use, for the fold angles.
-    let mut edges: FxHashMap<[u32; 2], Vec<(u32, u32)>> = Default::default();
-    for (t, tri) in surface.triangles.iter().enumerate() {
-        let poor = min_angle_3d_deg(&surface.corners(t)) < threshold_deg;
-        triangles.insert(sorted3(*tri), poor);
-        for k in 0..3 {
-            let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            edges
-                .entry([a.min(b), a.max(b)])
-                .or_default()
-                .push((t as u32, tri[(k + 2) % 3]));
-        }
-    }
+    // Half-edge 3t+k runs from corner k of triangle t to corner k+1; its use of the edge is
+    // (triangle t, opposite corner k+2).
+    let edge_key = |h: u32| {
+        let tri = surface.triangles[h as usize / 3];
+        let k = h as usize % 3;
+        let (a, b) = (tri[k], tri[(k + 1) % 3]);
+        [a.min(b), a.max(b)]
+    };
+    let mut edges: Vec<u32> = (0..3 * surface.triangles.len() as u32).collect();
+    edges.sort_unstable_by(|&a, &b| edge_key(a).cmp(&edge_key(b)).then(a.cmp(&b)));
+    let opposite = |h: u32| surface.triangles[h as usize / 3][(h as usize % 3 + 2) % 3];
     let mut placement = Vec::with_capacity(mesh.tets.len());
     let mut forced = Vec::with_capacity(mesh.tets.len());
     for (t, tet) in mesh.tets.iter().enumerate() {
@@ -119,9 +114,12 @@ pub fn classify(mesh: &TetMesh, surface: &SurfaceMesh, threshold_deg: f64) -> Fo
                 if k.contains(&u32::MAX) {
                     continue;
                 }
-                if let Some(&poor) = triangles.get(&sorted3(k)) {
+                let k = sorted3(k);
+                // Of repeated triangles, the last (as a map's last insert).
+                let n = triangles.partition_point(|&i| tri_key(i) <= k);
+                if n > 0 && tri_key(triangles[n - 1]) == k {
                     place = Placement::Face;
-                    is_forced |= poor;
+                    is_forced |= poor[triangles[n - 1] as usize];
                 }
             }
         }
@@ -135,13 +133,15 @@ pub fn classify(mesh: &TetMesh, surface: &SurfaceMesh, threshold_deg: f64) -> Fo
                 if a == u32::MAX || b == u32::MAX {
                     continue;
                 }
-                let Some(uses) = edges.get(&[a.min(b), a.max(b)]) else {
-                    continue;
-                };
+                let k = [a.min(b), a.max(b)];
+                let lo = edges.partition_point(|&h| edge_key(h) < k);
+                let hi = lo + edges[lo..].partition_point(|&h| edge_key(h) == k);
+                let uses = &edges[lo..hi];
                 if uses.len() >= 2 && angles[e].to_degrees() < threshold_deg {
                     // The tet's own angle at an input edge is below the threshold; it is forced
                     // when the surface's wedge there (on the tet's side) is below it too.
-                    if wedge_below(surface, uses, &c, i, j, threshold_deg) {
+                    let opp = uses.iter().map(|&h| opposite(h));
+                    if wedge_below(surface, opp, &c, i, j, threshold_deg) {
                         is_forced = true;
                         break;
                     }
@@ -158,7 +158,7 @@ pub fn classify(mesh: &TetMesh, surface: &SurfaceMesh, threshold_deg: f64) -> Fo
 /// angle is below the threshold: the two triangles nearest the tet on either side enclose it.
 fn wedge_below(
     surface: &SurfaceMesh,
-    uses: &[(u32, u32)],
+    opposite: impl Iterator<Item = u32>,
     c: &[[f64; 3]; 4],
     i: usize,
     j: usize,
@@ -191,7 +191,7 @@ fn wedge_below(
     // The tet's middle direction is angle 0; the nearest triangle on each side bounds the wedge.
     let mut lo = -std::f64::consts::PI;
     let mut hi = std::f64::consts::PI;
-    for &(_, opp) in uses {
+    for opp in opposite {
         let th = angle(surface.points[opp as usize]);
         if th < 0.0 {
             lo = lo.max(th);
