@@ -215,7 +215,8 @@ struct Work<'a> {
     nb: Vec<[u32; 4]>,
     labels: Vec<u32>,
     alive: Vec<bool>,
-    rounds: Vec<u32>,
+    /// Per tet: refills since the start that made it (at most `max_rounds` + 1 matters).
+    rounds: Vec<u8>,
     /// Per tet: 0 unknown, 1 forced, 2 not forced.
     forced: Vec<u8>,
     /// Per point: on a boundary or interface face (fixed: those faces never change).
@@ -234,15 +235,17 @@ struct Work<'a> {
     /// Per point: the last batch whose fill changed a tet with this corner.
     changed_at: Vec<u32>,
     /// Per tet: the stamp of the last star walk that met it (see [`Work::star`]).
-    star_mark: Vec<u32>,
-    star_stamp: u32,
+    star_mark: Vec<u8>,
+    star_stamp: u8,
     free: Vec<u32>,
     /// Per tet: its local moves were tried and failed (it waits for its larger cavities).
     local_tried: Vec<bool>,
     opts: ImproveOptions,
     report: ImproveReport,
-    call_ms: Vec<f64>,
-    call_nodes: Vec<u64>,
+    /// Per search: milliseconds and nodes (for the medians; a byte count per search matters on
+    /// large meshes).
+    call_ms: Vec<f32>,
+    call_nodes: Vec<u32>,
     queue: BinaryHeap<Entry>,
 }
 
@@ -499,12 +502,13 @@ impl<'a> Work<'a> {
         plan: &Plan,
         counts: fn(&mut ImproveReport) -> &mut MoveCounts,
     ) -> bool {
-        self.call_ms.push(out.ms);
+        self.call_ms.push(out.ms as f32);
         counts(&mut self.report).calls += 1;
         counts(&mut self.report).ms += out.ms;
         match &out.result {
             Ok(fill) => {
-                self.call_nodes.push(fill.nodes_visited);
+                self.call_nodes
+                    .push(fill.nodes_visited.min(u32::MAX as u64) as u32);
                 if out.accepted(plan) {
                     counts(&mut self.report).accepted += 1;
                     true
@@ -558,7 +562,7 @@ impl<'a> Work<'a> {
             .map(|&t| self.rounds[t as usize])
             .max()
             .unwrap_or(0)
-            + 1;
+            .saturating_add(1);
         for &t in &cav.tets {
             self.alive[t as usize] = false;
             self.free.push(t);
@@ -602,7 +606,9 @@ impl<'a> Work<'a> {
         crate::mesh::cavity::stitch(&self.tets, &mut self.nb, &ids, &cav.shell, &cav.outer);
         for &t in &ids {
             let v = self.value(t);
-            if v < self.opts.threshold && self.rounds[t as usize] <= self.opts.max_rounds {
+            // (`rounds` saturates at 255.)
+            let max_rounds = self.opts.max_rounds.min(254);
+            if v < self.opts.threshold && u32::from(self.rounds[t as usize]) <= max_rounds {
                 self.queue_push(v, t);
             }
         }
@@ -1058,7 +1064,16 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
         }
     }
     run_queue(&mut w);
-    // Compact.
+    // Compact, with the per-tet side arrays freed first (the index below would sit on top of
+    // them at the stage's peak).
+    for v in [&mut w.claim, &mut w.tried_at] {
+        *v = Vec::new();
+    }
+    for v in [&mut w.forced, &mut w.star_mark, &mut w.rounds] {
+        *v = Vec::new();
+    }
+    w.cache = Vec::new();
+    w.local_tried = Vec::new();
     let mut index = vec![NO_NEIGHBOR; w.tets.len()];
     let mut k = 0u32;
     for (t, slot) in index.iter_mut().enumerate() {
@@ -1106,14 +1121,16 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     report.n_bad_after = bad_after;
     report.n_tets_after = tets.len();
     let mut ms = std::mem::take(&mut w.call_ms);
-    ms.sort_by(f64::total_cmp);
+    ms.sort_by(f32::total_cmp);
     let mut nodes = std::mem::take(&mut w.call_nodes);
     nodes.sort_unstable();
     report.calls = ms.len();
-    report.call_ms_median = ms.get(ms.len() / 2).copied().unwrap_or(0.0);
-    report.call_ms_max = ms.last().copied().unwrap_or(0.0);
-    report.nodes_median = nodes.get(nodes.len() / 2).copied().unwrap_or(0);
+    report.call_ms_median = ms.get(ms.len() / 2).map_or(0.0, |&x| f64::from(x));
+    report.call_ms_max = ms.last().map_or(0.0, |&x| f64::from(x));
+    report.nodes_median = nodes.get(nodes.len() / 2).map_or(0, |&x| u64::from(x));
     drop(w);
+    // The workers' buffers go too (they would stay with the threads for the rest of the run).
+    rayon::broadcast(|_| SCRATCH.take());
     mesh.tets = tets;
     mesh.neighbors = nb;
     mesh.labels = labels;
