@@ -12,10 +12,10 @@
 use crate::geom::predicates::{Sign, orient3d};
 use crate::geom::vec3::{add, cross, norm, norm2, scale, sub};
 use crate::mesh::tet::{TET_EDGES, TET_FACES};
-use crate::quality::tet::{dihedral_angles, dihedral_at};
+use crate::quality::tet::dihedral_at;
 use crate::smooth::ascent::{MAX_ACTIVE, min_norm_point};
 
-use super::work::{P3, Work};
+use super::work::{P3, Work, angles_upto};
 
 /// Step parameters of [`Work::relocate`].
 #[derive(Debug, Clone, Copy)]
@@ -36,6 +36,8 @@ struct Member {
     c: [P3; 4],
     k: usize,
     floor: f64,
+    /// `angle(floor)`.
+    floor_rad: f64,
     forced: bool,
 }
 
@@ -58,10 +60,12 @@ impl Work {
                 .position(|&x| x == v)
                 .unwrap_or(0);
             let m = chords(&c).into_iter().fold(f64::INFINITY, f64::min);
+            let floor = m.min(chord(threshold_rad));
             members.push(Member {
                 c,
                 k,
-                floor: m.min(chord(threshold_rad)),
+                floor,
+                floor_rad: angle(floor),
                 forced: self.is_forced(t),
             });
         }
@@ -91,11 +95,18 @@ impl Work {
             for m in &members {
                 let mut c = m.c;
                 c[m.k] = x;
-                let a = dihedral_angles(&c);
+                // Only angles that can pass one of the two tests below need their value.
+                let floor_rad = m.floor_rad + p.tie;
+                let upto = if m.forced {
+                    floor_rad
+                } else {
+                    floor_rad.max(phi_rad + p.tie)
+                };
+                let a = angles_upto(&c, upto);
                 for (e, &ae) in a.iter().enumerate() {
                     // The tied minimum, and angles about to hit their floor.
                     let tied = !m.forced && ae <= phi_rad + p.tie;
-                    if !tied && ae > angle(m.floor) + p.tie {
+                    if !tied && ae > floor_rad {
                         continue;
                     }
                     let g = [0, 1, 2].map(|axis| {
