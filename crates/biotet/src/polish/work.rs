@@ -367,3 +367,77 @@ fn pseudo([y, x]: [f64; 2]) -> f64 {
 fn widen(p: f64) -> f64 {
     p * (1.0 + 1e-9) + 1e-290
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::quality::tet::dihedral_angles;
+
+    /// The screened measures are those of `dihedral_angles` bit for bit, on regular, flat,
+    /// needle, sliver and random tets (ties between equal angles included).
+    #[test]
+    fn screened_angles_match_every_angle_bit_for_bit() {
+        let mut tets: Vec<[P3; 4]> = vec![
+            [
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.0, 0.0, 1.0],
+            ],
+            [
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [1.0, 1.0, 0.0],
+            ],
+            [
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.5, 0.5, 1e-12],
+            ],
+            [
+                [0.0, 0.0, 0.0],
+                [1e-9, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.0, 0.0, 1.0],
+            ],
+            [
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 0.0, 1.0],
+            ],
+        ];
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        let mut r = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        for _ in 0..2000 {
+            tets.push([0, 1, 2, 3].map(|_| [r(), r(), r()]));
+        }
+        for _ in 0..500 {
+            // Slivers: four points near a plane.
+            let h = 1e-4 * r();
+            tets.push([0, 1, 2, 3].map(|_| [r(), r(), h * r()]));
+        }
+        for c in &tets {
+            let a = dihedral_angles(c);
+            let m = a.iter().copied().fold(f64::INFINITY, f64::min).to_degrees();
+            assert_eq!(min_deg(c).to_bits(), m.to_bits(), "{c:?}");
+            for lim in [0.01, 0.1, 0.2, 1.0, 2.0, 3.2, -1.0] {
+                let u = angles_upto(c, lim);
+                for e in 0..6 {
+                    if a[e] <= lim {
+                        assert_eq!(u[e].to_bits(), a[e].to_bits(), "{c:?} {lim}");
+                    } else {
+                        assert!(u[e] == f64::INFINITY || u[e].to_bits() == a[e].to_bits());
+                    }
+                }
+            }
+        }
+    }
+}
