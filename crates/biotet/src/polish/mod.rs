@@ -28,6 +28,8 @@ use std::time::Instant;
 
 use serde::Serialize;
 
+use rayon::prelude::*;
+
 use crate::lastresort::Searcher;
 use crate::mesh::tet::{NO_NEIGHBOR, TetMesh};
 use crate::quality::tet::min_dihedral_chord2;
@@ -125,9 +127,8 @@ pub fn polish(mesh: &mut TetMesh, opts: &PolishOptions) -> PolishReport {
         halvings: 8,
         tie: 0.5f64.to_radians(),
     };
-    let n = w.tets.len() as u32;
     let np0 = w.pts.len();
-    let mut bad = scan(&mut w, 0..n, thr);
+    let mut bad = scan_all(&mut w, thr);
     report.ms[0] = clock.elapsed().as_secs_f64() * 1e3;
     report.n_bad_before = bad.len();
     report.bad_before_by_interior_corners = by_interior_corners(&w, &bad);
@@ -201,10 +202,9 @@ pub fn polish(mesh: &mut TetMesh, opts: &PolishOptions) -> PolishReport {
         // Only tets that changed are retried: the others would fail as before.
         touched.sort_unstable();
         touched.dedup();
-        bad = scan(&mut w, touched.into_iter(), thr);
+        bad = scan(&mut w, &touched, thr);
     }
-    let n = w.tets.len() as u32;
-    let mut bad = scan(&mut w, 0..n, thr);
+    let mut bad = scan_all(&mut w, thr);
     if opts.insert {
         // Steiner points last, once per tet still bad, worst first.
         let c = Instant::now();
@@ -222,8 +222,7 @@ pub fn polish(mesh: &mut TetMesh, opts: &PolishOptions) -> PolishReport {
             }
         }
         if any {
-            let n = w.tets.len() as u32;
-            bad = scan(&mut w, 0..n, thr);
+            bad = scan_all(&mut w, thr);
             // One more round of moves around the tets still bad: the new points (and the
             // points next to them) may now move.
             {
@@ -243,8 +242,7 @@ pub fn polish(mesh: &mut TetMesh, opts: &PolishOptions) -> PolishReport {
                     }
                 }
                 if moved {
-                    let n = w.tets.len() as u32;
-                    bad = scan(&mut w, 0..n, thr);
+                    bad = scan_all(&mut w, thr);
                 }
             }
         }
@@ -324,23 +322,32 @@ fn move_corners(
     moved
 }
 
-/// The live unforced tets of `ts` below `thr` degrees with their angle, worst first.
-fn scan(w: &mut Work, ts: impl Iterator<Item = u32>, thr: f64) -> Vec<(f64, u32)> {
-    let mut out = Vec::new();
+/// The live unforced tets of `ts` below `thr` degrees with their angle, worst first. The
+/// measures in parallel (read only), the forced test after (it caches).
+fn scan(w: &mut Work, ts: &[u32], thr: f64) -> Vec<(f64, u32)> {
     // A trigonometry-free screen first (with a margin: the angle decides).
     let s = (thr.to_radians() / 2.0).sin();
     let lim = 4.0 * s * s * (1.0 + 1e-6);
-    for t in ts {
-        if !w.alive[t as usize] || min_dihedral_chord2(&w.corners(t)) > lim {
-            continue;
-        }
-        let a = w.min_angle(t);
-        if a < thr && !w.is_forced(t) {
-            out.push((a, t));
-        }
-    }
+    let view: &Work = w;
+    let mut out: Vec<(f64, u32)> = ts
+        .par_iter()
+        .filter_map(|&t| {
+            if !view.alive[t as usize] || min_dihedral_chord2(&view.corners(t)) > lim {
+                return None;
+            }
+            let a = view.min_angle(t);
+            (a < thr).then_some((a, t))
+        })
+        .collect();
+    out.retain(|&(_, t)| !w.is_forced(t));
     out.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     out
+}
+
+/// [`scan`] over every tet.
+fn scan_all(w: &mut Work, thr: f64) -> Vec<(f64, u32)> {
+    let all: Vec<u32> = (0..w.tets.len() as u32).collect();
+    scan(w, &all, thr)
 }
 
 /// How many of `bad` have 0, 1, 2, 3 or 4 interior corners.

@@ -12,10 +12,10 @@
 use crate::geom::predicates::{Sign, orient3d};
 use crate::geom::vec3::{add, cross, norm, norm2, scale, sub};
 use crate::mesh::tet::{TET_EDGES, TET_FACES};
-use crate::quality::tet::{dihedral_angles, dihedral_at};
+use crate::quality::tet::dihedral_at;
 use crate::smooth::ascent::{MAX_ACTIVE, min_norm_point};
 
-use super::work::{P3, Work};
+use super::work::{P3, Work, angles_upto};
 
 /// Step parameters of [`Work::relocate`].
 #[derive(Debug, Clone, Copy)]
@@ -36,6 +36,10 @@ struct Member {
     c: [P3; 4],
     k: usize,
     floor: f64,
+    /// `angle(floor)`.
+    floor_rad: f64,
+    /// The unit normal of the face opposite the moving point (it does not move).
+    uk: P3,
     forced: bool,
 }
 
@@ -57,11 +61,14 @@ impl Work {
                 .iter()
                 .position(|&x| x == v)
                 .unwrap_or(0);
-            let m = chords(&c).into_iter().fold(f64::INFINITY, f64::min);
+            let m = min_chord(&c, k, unit_normal(&c, k));
+            let floor = m.min(chord(threshold_rad));
             members.push(Member {
                 c,
                 k,
-                floor: m.min(chord(threshold_rad)),
+                floor,
+                floor_rad: angle(floor),
+                uk: unit_normal(&c, k),
                 forced: self.is_forced(t),
             });
         }
@@ -91,11 +98,18 @@ impl Work {
             for m in &members {
                 let mut c = m.c;
                 c[m.k] = x;
-                let a = dihedral_angles(&c);
+                // Only angles that can pass one of the two tests below need their value.
+                let floor_rad = m.floor_rad + p.tie;
+                let upto = if m.forced {
+                    floor_rad
+                } else {
+                    floor_rad.max(phi_rad + p.tie)
+                };
+                let a = angles_upto(&c, upto);
                 for (e, &ae) in a.iter().enumerate() {
                     // The tied minimum, and angles about to hit their floor.
                     let tied = !m.forced && ae <= phi_rad + p.tie;
-                    if !tied && ae > angle(m.floor) + p.tie {
+                    if !tied && ae > floor_rad {
                         continue;
                     }
                     let g = [0, 1, 2].map(|axis| {
@@ -140,14 +154,14 @@ impl Work {
     }
 }
 
-/// The smallest chord (see [`chords`]) of the unforced members with the point at `x`, if it
+/// The smallest chord (see [`min_chord`]) of the unforced members with the point at `x`, if it
 /// beats `beat` and no member falls below its floor (stops at the first failure).
 fn objective(members: &[Member], x: P3, beat: f64) -> Option<f64> {
     let mut phi = f64::INFINITY;
     for m in members {
         let mut c = m.c;
         c[m.k] = x;
-        let a = chords(&c).into_iter().fold(f64::INFINITY, f64::min);
+        let a = min_chord(&c, m.k, m.uk);
         if a.is_nan() || a < m.floor || (!m.forced && a <= beat) {
             return None;
         }
@@ -158,17 +172,21 @@ fn objective(members: &[Member], x: P3, beat: f64) -> Option<f64> {
     Some(phi)
 }
 
-/// `4·sin²(θ/2)` of the six dihedral angles θ (increasing in θ; no trigonometry): `|u + v|²` of
-/// the unit outward normals of the two faces at each edge. NaN for a degenerate tet.
-fn chords(c: &[P3; 4]) -> [f64; 6] {
-    let u = [0, 1, 2, 3].map(|i| {
-        let l = TET_FACES[i];
-        let n = cross(sub(c[l[1]], c[l[0]]), sub(c[l[2]], c[l[0]]));
-        scale(n, 1.0 / norm(n))
-    });
-    let mut out = [0.0; 6];
-    for (e, [k, l]) in TET_EDGES.iter().rev().enumerate() {
-        out[e] = norm2(add(u[*k], u[*l]));
+/// The unit outward normal of the face opposite corner `i` (NaN for a degenerate face).
+fn unit_normal(c: &[P3; 4], i: usize) -> P3 {
+    let l = TET_FACES[i];
+    let n = cross(sub(c[l[1]], c[l[0]]), sub(c[l[2]], c[l[0]]));
+    scale(n, 1.0 / norm(n))
+}
+
+/// The smallest `4·sin²(θ/2)` of the six dihedral angles θ (increasing in θ; no trigonometry):
+/// `|u + v|²` of the unit outward normals of the two faces at each edge, `uk` the one opposite
+/// corner `k`. NaN for a degenerate tet.
+fn min_chord(c: &[P3; 4], k: usize, uk: P3) -> f64 {
+    let u = [0, 1, 2, 3].map(|i| if i == k { uk } else { unit_normal(c, i) });
+    let mut out = f64::INFINITY;
+    for [i, j] in TET_EDGES.iter().rev() {
+        out = out.min(norm2(add(u[*i], u[*j])));
     }
     out
 }

@@ -2,7 +2,7 @@
 //! points are fixed (on a boundary or interface face) and which tets the input forces poor.
 
 use crate::mesh::tet::{NO_NEIGHBOR, TET_EDGES, TET_FACES, TetMesh};
-use crate::quality::tet::{dihedral_angles, dihedral_at};
+use crate::quality::tet::{dihedral_at, dihedral_yx};
 use crate::quality::tri::min_angle_3d_deg;
 
 pub(super) type P3 = [f64; 3];
@@ -175,19 +175,17 @@ impl Work {
         }
         for e in TET_EDGES {
             let (a, b) = (tv[e[0]], tv[e[1]]);
-            if self.fixed[a as usize]
-                && self.fixed[b as usize]
-                && self.wedge(t, a, b).is_some_and(|w| w.to_degrees() < lim)
-            {
+            if self.fixed[a as usize] && self.fixed[b as usize] && self.wedge_below(t, a, b, lim) {
                 return true;
             }
         }
         false
     }
 
-    /// The region's wedge at edge `ab` of `t` (the sum of the angles there of the region's tets
-    /// around it) when the edge is on the region's boundary; `None` for an interior edge.
-    fn wedge(&self, t: u32, a: u32, b: u32) -> Option<f64> {
+    /// Whether edge `ab` of `t` is on the region's boundary with the region's wedge there (the
+    /// sum of the angles of the region's tets around it) below `lim` degrees. The walk stops
+    /// once the partial sum reaches `lim`: the angles are not negative, so the sum only grows.
+    fn wedge_below(&self, t: u32, a: u32, b: u32, lim: f64) -> bool {
         let label = self.labels[t as usize];
         let angle_at = |s: u32| {
             let tv = self.tets[s as usize];
@@ -200,6 +198,9 @@ impl Work {
             dihedral_at(&self.corners(s), e)
         };
         let mut sum = angle_at(t);
+        if sum.to_degrees() >= lim {
+            return false;
+        }
         let mut open = false;
         let tv = self.tets[t as usize];
         for (i, &x) in tv.iter().enumerate() {
@@ -214,10 +215,13 @@ impl Work {
                     break;
                 }
                 if s == t || steps > 64 {
-                    return None;
+                    return false;
                 }
                 steps += 1;
                 sum += angle_at(s);
+                if sum.to_degrees() >= lim {
+                    return false;
+                }
                 let v = self.tets[s as usize];
                 let next = (0..4)
                     .filter(|&k| v[k] != a && v[k] != b)
@@ -228,7 +232,7 @@ impl Work {
                 s = next;
             }
         }
-        open.then_some(sum)
+        open && sum.to_degrees() < lim
     }
 
     /// The cavity of `tets` (all of one label).
@@ -304,11 +308,136 @@ impl Work {
     }
 }
 
-/// The smallest dihedral angle of a tet, degrees.
+/// The smallest dihedral angle of a tet, degrees: bit for bit the smallest of
+/// [`crate::quality::tet::dihedral_angles`], with `atan2` taken only of the edges that can be it.
 pub(super) fn min_deg(c: &[P3; 4]) -> f64 {
-    dihedral_angles(c)
-        .iter()
-        .copied()
-        .fold(f64::INFINITY, f64::min)
-        .to_degrees()
+    let yx = dihedral_yx(c);
+    let p = yx.map(pseudo);
+    let mut m = f64::INFINITY;
+    if p.iter().all(|v| v.is_finite()) {
+        let lim = widen(p.iter().copied().fold(f64::INFINITY, f64::min));
+        for (e, &[y, x]) in yx.iter().enumerate() {
+            if p[e] <= lim {
+                m = m.min(y.atan2(x));
+            }
+        }
+    } else {
+        for [y, x] in yx {
+            m = m.min(y.atan2(x));
+        }
+    }
+    m.to_degrees()
+}
+
+/// The dihedral angles (radians) of a tet that may be at most `a` radians, bit for bit those of
+/// [`crate::quality::tet::dihedral_angles`]; the others are `f64::INFINITY`.
+pub(super) fn angles_upto(c: &[P3; 4], a: f64) -> [f64; 6] {
+    let yx = dihedral_yx(c);
+    let all = a >= std::f64::consts::PI;
+    let lim = if all {
+        f64::INFINITY
+    } else if a < 0.0 {
+        -1.0
+    } else {
+        widen(pseudo([a.sin(), a.cos()]))
+    };
+    let p = yx.map(pseudo);
+    let all = all || !p.iter().all(|v| v.is_finite());
+    let mut out = [f64::INFINITY; 6];
+    for (e, &[y, x]) in yx.iter().enumerate() {
+        if all || p[e] <= lim {
+            out[e] = y.atan2(x);
+        }
+    }
+    out
+}
+
+/// A trigonometry-free stand-in for `y.atan2(x)` with `y ≥ 0`: increasing in the angle, from 0
+/// to 2, with a small relative error everywhere (no cancellation near 0).
+fn pseudo([y, x]: [f64; 2]) -> f64 {
+    if x >= 0.0 {
+        y / (x + y)
+    } else {
+        2.0 - y / (y - x)
+    }
+}
+
+/// A screen's bound loosened far past the rounding of [`pseudo`] and `atan2`, so an angle left
+/// out is certainly above the one it is compared with.
+fn widen(p: f64) -> f64 {
+    p * (1.0 + 1e-9) + 1e-290
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::quality::tet::dihedral_angles;
+
+    /// The screened measures are those of `dihedral_angles` bit for bit, on regular, flat,
+    /// needle, sliver and random tets (ties between equal angles included).
+    #[test]
+    fn screened_angles_match_every_angle_bit_for_bit() {
+        let mut tets: Vec<[P3; 4]> = vec![
+            [
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.0, 0.0, 1.0],
+            ],
+            [
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [1.0, 1.0, 0.0],
+            ],
+            [
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.5, 0.5, 1e-12],
+            ],
+            [
+                [0.0, 0.0, 0.0],
+                [1e-9, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.0, 0.0, 1.0],
+            ],
+            [
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 0.0, 1.0],
+            ],
+        ];
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        let mut r = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        for _ in 0..2000 {
+            tets.push([0, 1, 2, 3].map(|_| [r(), r(), r()]));
+        }
+        for _ in 0..500 {
+            // Slivers: four points near a plane.
+            let h = 1e-4 * r();
+            tets.push([0, 1, 2, 3].map(|_| [r(), r(), h * r()]));
+        }
+        for c in &tets {
+            let a = dihedral_angles(c);
+            let m = a.iter().copied().fold(f64::INFINITY, f64::min).to_degrees();
+            assert_eq!(min_deg(c).to_bits(), m.to_bits(), "{c:?}");
+            for lim in [0.01, 0.1, 0.2, 1.0, 2.0, 3.2, -1.0] {
+                let u = angles_upto(c, lim);
+                for e in 0..6 {
+                    if a[e] <= lim {
+                        assert_eq!(u[e].to_bits(), a[e].to_bits(), "{c:?} {lim}");
+                    } else {
+                        assert!(u[e] == f64::INFINITY || u[e].to_bits() == a[e].to_bits());
+                    }
+                }
+            }
+        }
+    }
 }

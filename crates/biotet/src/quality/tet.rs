@@ -23,6 +23,19 @@ pub fn dihedral_angles(c: &[[f64; 3]; 4]) -> [f64; 6] {
     out
 }
 
+/// The `[y, x]` pairs whose `y.atan2(x)` is [`dihedral_angles`]`(c)[e]` bit for bit (`y ≥ 0`),
+/// for callers that order or screen the angles without trigonometry and take `atan2` of a few.
+pub fn dihedral_yx(c: &[[f64; 3]; 4]) -> [[f64; 2]; 6] {
+    let n = face_normals(c);
+    let mut out = [[0.0; 2]; 6];
+    for (e, o) in out.iter_mut().enumerate() {
+        let [k, l] = TET_EDGES[5 - e];
+        let (nk, nl) = (n[k], n[l]);
+        *o = [norm(cross(nk, nl)), -dot(nk, nl)];
+    }
+    out
+}
+
 /// The interior dihedral angle (radians) at edge `e` of [`TET_EDGES`] alone: the same value as
 /// `dihedral_angles(c)[e]`, for callers that need one edge.
 pub fn dihedral_at(c: &[[f64; 3]; 4], e: usize) -> f64 {
@@ -268,6 +281,10 @@ mod tests {
             let m = TetMeasures::of(c);
             assert_eq!(min_dihedral_deg(c).to_bits(), m.min_dihedral().to_bits());
             assert_eq!(min_solid_sr(c).to_bits(), m.min_solid().to_bits());
+            let a = dihedral_angles(c);
+            for (e, [y, x]) in dihedral_yx(c).into_iter().enumerate() {
+                assert_eq!(y.atan2(x).to_bits(), a[e].to_bits());
+            }
         }
     }
 }
