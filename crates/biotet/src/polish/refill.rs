@@ -148,7 +148,7 @@ impl Work {
                 continue;
             }
             let so = p.options(floor);
-            if let Ok(f) = searcher.fill(&self.pts, &cav.shell, &inner, &so) {
+            if let Ok(f) = searcher.fill_carved(&self.pts, &cav.shell, &inner, &so) {
                 fill = Some(f);
                 break;
             }
