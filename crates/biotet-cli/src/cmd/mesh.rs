@@ -173,6 +173,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
     let (_, rss_before_kb) = super::delaunay::memory_kb();
     map_mesh_sized_blocks();
 
+    let clock = Instant::now();
     let spec = match (a.size, &a.size_field) {
         (Some(h), _) => SizeSpec::Uniform(h),
         (None, Some(path)) => {
@@ -197,6 +198,8 @@ pub fn run(a: Args) -> Result<ExitCode> {
     sizing.max_size = a.max_size;
     sizing.region_sizes = parse_region_sizes(&a.region_size)?;
     let sizing = Sizing::new(&surface, sizing).context("sizing")?;
+    // Part of meshing: the surface-derived size is built from the surface here.
+    let seconds_sizing = clock.elapsed().as_secs_f64();
 
     let mut opts = PipelineOptions::default();
     opts.deploy.resolution = a.resolution;
@@ -262,6 +265,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
             "n_surface_triangles": surface.triangles.len(),
             "shells": shells,
             "seconds_read_validate": seconds_read,
+            "seconds_sizing": seconds_sizing,
             "pipeline": report,
             "quality": quality,
             "forcing": forcing,
