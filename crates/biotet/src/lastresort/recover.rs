@@ -55,6 +55,7 @@
 use super::cells::Cells;
 use super::search::{SearchError, SearchOptions, Searcher, bbox, boxes_apart};
 use crate::delaunay::Delaunay;
+use crate::geom::filter::orient3d as orient3d_fast;
 use crate::geom::intersect::{TriTri, tri_tri};
 use crate::geom::predicates::{Sign, in_exact_range, orient3d};
 use crate::mesh::coord_key;
@@ -264,19 +265,25 @@ fn recover_checked(
     drop(at);
 
     let mut r = Recovery::new(mesh, surface, tri_map, *opts);
+    r.scan_present();
     let missing_before = r.count_missing();
     let domain = r.cover()?;
+    if domain != Domain::Convex {
+        // Tets put back may hold surface triangles.
+        r.scan_present();
+    }
     r.run();
     if opts.allow_interior_steiner {
         r.run_steiner();
     }
     r.compact();
     let (removed, conflicts) = r.relabel();
+    r.scan_present();
 
     let mut unrecovered = Vec::new();
     for (s, m) in r.tri_map.iter().enumerate() {
-        let present = m.is_some_and(|v| r.present(v));
-        if !present {
+        debug_assert_eq!(r.is_present[s], m.is_some_and(|v| r.present(v)));
+        if !r.is_present[s] {
             let corners = surface.corners(s);
             unrecovered.push(Unrecovered {
                 triangle: s,
@@ -392,6 +399,14 @@ struct Recovery<'a> {
     opts: RecoverOptions,
     /// Surface triangles in mesh point numbers (`None`: a corner is no mesh point).
     tri_map: Vec<Option<[u32; 3]>>,
+    /// Mapped surface triangles by sorted corners (the last of equal ones) ...
+    face_tri: FxHashMap<[u32; 3], u32>,
+    /// ... and the previous triangle with the same corners (`NO_NEIGHBOR`: none).
+    same_face: Vec<u32>,
+    /// Which surface triangles are faces of live tets: set by [`Self::scan_present`], then kept
+    /// by [`Self::insert`] (carving never removes a present triangle: it is kept as a shell
+    /// face or refilled as a constrained one).
+    is_present: Vec<bool>,
     alive: Vec<bool>,
     free: Vec<u32>,
     /// A live tet at each point (`NO_NEIGHBOR` for none): stars are walked from it across the
@@ -406,6 +421,11 @@ struct Recovery<'a> {
     surf_start: Vec<u32>,
     surf_list: Vec<u32>,
     tet_mark: Vec<u32>,
+    /// Cached sides of points of the plane of the triangle whose crossed tets are walked.
+    side_mark: Vec<u32>,
+    side: Vec<Sign>,
+    /// The stack of that walk.
+    walk_buf: Vec<u32>,
     pt_mark: Vec<u32>,
     pt_local: Vec<u32>,
     stamp: u32,
@@ -500,11 +520,24 @@ impl<'a> Recovery<'a> {
             }
         }
         drop(fill);
+        let mut face_tri = FxHashMap::default();
+        face_tri.reserve(tri_map.len());
+        let mut same_face = vec![NO_NEIGHBOR; tri_map.len()];
+        for (s, m) in tri_map.iter().enumerate() {
+            if let Some(v) = m
+                && let Some(prev) = face_tri.insert(sorted3(*v), s as u32)
+            {
+                same_face[s] = prev;
+            }
+        }
         let mut r = Recovery {
             mesh,
             surface,
             opts,
             tri_map,
+            face_tri,
+            same_face,
+            is_present: Vec::new(),
             alive: Vec::new(),
             free: Vec::new(),
             vtet: Vec::new(),
@@ -514,6 +547,9 @@ impl<'a> Recovery<'a> {
             surf_start,
             surf_list,
             tet_mark: Vec::new(),
+            side_mark: vec![0; np],
+            side: vec![Sign::Zero; np],
+            walk_buf: Vec::new(),
             pt_mark: vec![0; np],
             pt_local: vec![0; np],
             stamp: 0,
@@ -602,17 +638,45 @@ impl<'a> Recovery<'a> {
         })
     }
 
+    /// Surface triangles missing (by [`Self::is_present`]).
     fn count_missing(&self) -> usize {
-        self.tri_map
-            .iter()
-            .filter(|m| !m.is_some_and(|v| self.present(v)))
-            .count()
+        self.is_present.iter().filter(|&&p| !p).count()
     }
 
     /// The missing triangles whose corners are all mesh points.
     fn missing_mapped(&self) -> impl Iterator<Item = u32> + '_ {
         (0..self.tri_map.len() as u32)
-            .filter(|&s| self.tri_map[s as usize].is_some_and(|v| !self.present(v)))
+            .filter(|&s| self.tri_map[s as usize].is_some() && !self.is_present[s as usize])
+    }
+
+    /// Set [`Self::is_present`] from scratch: one pass over the tets' faces (cheaper than a star
+    /// walk per triangle).
+    fn scan_present(&mut self) {
+        self.is_present.clear();
+        self.is_present.resize(self.tri_map.len(), false);
+        for t in 0..self.mesh.tets.len() {
+            if self.alive[t] {
+                self.mark_present(t);
+            }
+        }
+    }
+
+    /// Mark the surface triangles that are faces of tet `t` present.
+    fn mark_present(&mut self, t: usize) {
+        let tv = self.mesh.tets[t];
+        let on = tv.map(|x| self.surf_start[x as usize] != self.surf_start[x as usize + 1]);
+        for (f, g) in TET_FACES.iter().enumerate() {
+            if !(on[g[0]] && on[g[1]] && on[g[2]]) {
+                continue;
+            }
+            if let Some(&s) = self.face_tri.get(&sorted3(self.mesh.face(t, f))) {
+                let mut s = s;
+                while s != NO_NEIGHBOR {
+                    self.is_present[s as usize] = true;
+                    s = self.same_face[s as usize];
+                }
+            }
+        }
     }
 
     /// Make the mesh cover the convex hull of its points (module docs, step 1).
@@ -664,7 +728,7 @@ impl<'a> Recovery<'a> {
             let Some(v) = self.tri_map[s as usize] else {
                 continue;
             };
-            if self.present(v) {
+            if self.is_present[s as usize] {
                 continue;
             }
             if stalled > queue.len() {
@@ -743,18 +807,41 @@ impl<'a> Recovery<'a> {
         self.stamp += 1;
         let st = self.stamp;
         let mut out = Vec::new();
-        let mut stack: Vec<u32> = Vec::new();
+        let mut stack = std::mem::take(&mut self.walk_buf);
+        let mut star = self.star_buf.take();
+        stack.clear();
         for &c in &v {
-            for t in self.star(c) {
+            self.star_into(c, &mut star);
+            for &t in &star {
                 if self.tet_mark[t as usize] != st {
                     self.tet_mark[t as usize] = st;
                     stack.push(t);
                 }
             }
         }
+        self.star_buf.set(star);
         while let Some(t) = stack.pop() {
             let mut crossed = false;
+            let tv = self.mesh.tets[t as usize];
+            // Each corner's side of the plane of `v` (exact, once per point and walk).
+            let side = tv.map(|x| self.side_of(x, &tp, st));
             for f in 0..4 {
+                // A face with its corners off the plane on one side, or on it only at corners of
+                // `v`, meets `v` at most in shared corners or a shared edge: `tri_tri` would not
+                // call it improper (same answer, without its tests).
+                let mut pos = false;
+                let mut neg = false;
+                let mut stray = false;
+                for &k in &TET_FACES[f] {
+                    match side[k] {
+                        Sign::Positive => pos = true,
+                        Sign::Negative => neg = true,
+                        Sign::Zero => stray |= !v.contains(&tv[k]),
+                    }
+                }
+                if !stray && !(pos && neg) && (pos || neg) {
+                    continue;
+                }
                 let g = self.mesh.face(t as usize, f);
                 let gp = g.map(|x| self.mesh.points[x as usize]);
                 let (glo, ghi) = bbox(&gp);
@@ -774,15 +861,27 @@ impl<'a> Recovery<'a> {
             if crossed {
                 out.push(t);
                 if out.len() > CROSSED_MAX_TETS {
+                    self.walk_buf = stack;
                     return None;
                 }
             }
         }
+        self.walk_buf = stack;
         if out.is_empty() {
             return None;
         }
         out.sort_unstable();
         Some(out)
+    }
+
+    /// The side of point `x` of the plane through `tp` (exact), cached for stamp `st`.
+    fn side_of(&mut self, x: u32, tp: &[P3; 3], st: u32) -> Sign {
+        let i = x as usize;
+        if self.side_mark[i] != st {
+            self.side_mark[i] = st;
+            self.side[i] = orient3d_fast(tp[0], tp[1], tp[2], self.mesh.points[i]);
+        }
+        self.side[i]
     }
 
     /// Add the next ring: every tet across a face of the cavity.
@@ -1181,6 +1280,9 @@ impl<'a> Recovery<'a> {
                 }
             }
         }
+        for &s in &slots {
+            self.mark_present(s as usize);
+        }
     }
 
     /// Put one point strictly inside the cavity: the average of the cavity's points, when it
@@ -1208,6 +1310,8 @@ impl<'a> Recovery<'a> {
         self.vtet.push(NO_NEIGHBOR);
         self.surf_start.push(self.surf_list.len() as u32);
         self.pt_mark.push(self.stamp);
+        self.side_mark.push(0);
+        self.side.push(Sign::Zero);
         self.pt_local.push(cav.points.len() as u32);
         cav.points.push(id);
         cav.coords.push(p);
@@ -1232,7 +1336,7 @@ impl<'a> Recovery<'a> {
             let Some(v) = self.tri_map[s as usize] else {
                 continue;
             };
-            if self.present(v) {
+            if self.is_present[s as usize] {
                 continue;
             }
             let n0 = self.mesh.points.len();
@@ -1254,6 +1358,8 @@ impl<'a> Recovery<'a> {
             self.vtet.pop();
             self.surf_start.pop();
             self.pt_mark.pop();
+            self.side_mark.pop();
+            self.side.pop();
             self.pt_local.pop();
         }
     }
@@ -1310,16 +1416,10 @@ impl<'a> Recovery<'a> {
     /// Flood-fill region labels from the surface's side labels and remove region 0. Returns
     /// (tets removed, regions with conflicting votes).
     fn relabel(&mut self) -> (usize, usize) {
-        let mut wall: FxHashMap<[u32; 3], u32> = FxHashMap::default();
-        let mut on_surface = vec![false; self.mesh.points.len()];
-        for (s, m) in self.tri_map.iter().enumerate() {
-            if let Some(v) = m {
-                wall.insert(sorted3(*v), s as u32);
-                for &x in v {
-                    on_surface[x as usize] = true;
-                }
-            }
-        }
+        let wall = &self.face_tri;
+        let on_surface: Vec<bool> = (0..self.mesh.points.len())
+            .map(|x| self.surf_start[x] != self.surf_start[x + 1])
+            .collect();
         let n = self.mesh.tets.len();
         let mut comp = vec![u32::MAX; n];
         let mut conflicts = 0;
