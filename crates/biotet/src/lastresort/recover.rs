@@ -656,21 +656,21 @@ impl View<'_> {
             let tv = self.mesh.tets[t as usize];
             // Each corner's side of the plane of `v` (exact, once per point and walk).
             let side = tv.map(|x| self.side_of(w, x, &tp, st));
-            for f in 0..4 {
+            for (f, face) in TET_FACES.iter().enumerate() {
                 // A face with its corners off the plane on one side, or on it only at corners of
                 // `v`, meets `v` at most in shared corners or a shared edge: `tri_tri` would not
                 // call it improper (same answer, without its tests).
                 let mut pos = false;
                 let mut neg = false;
                 let mut stray = false;
-                for &k in &TET_FACES[f] {
+                for &k in face {
                     match side[k] {
                         Sign::Positive => pos = true,
                         Sign::Negative => neg = true,
                         Sign::Zero => stray |= !v.contains(&tv[k]),
                     }
                 }
-                if !stray && !(pos && neg) && (pos || neg) {
+                if !stray && pos != neg {
                     continue;
                 }
                 let g = self.mesh.face(t as usize, f);
@@ -1728,8 +1728,7 @@ impl<'a> Recovery<'a> {
             let mut conflict = false;
             while let Some(t) = stack.pop() {
                 members.push(t);
-                for f in 0..4 {
-                    let s = walls[t as usize][f];
+                for (f, &s) in walls[t as usize].iter().enumerate() {
                     if s != NO_NEIGHBOR
                         && let Some(v) = self.tri_map[s as usize]
                     {
