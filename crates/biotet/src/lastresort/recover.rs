@@ -31,6 +31,14 @@
 //!    tried again, up to [`RecoverOptions::max_grow`] times or [`RecoverOptions::max_cavity_tets`]
 //!    tets; a triangle whose cavity still fails moves to the back of the queue. The queue stops
 //!    when every remaining triangle failed since the last success.
+//!
+//!    **Batches.** The queue is taken 64 triangles at a time (no two sharing a corner:
+//!    they would carve the same tets). Their crossed-tets fills (the first two cavities of step
+//!    3, nearly every call) are searched in parallel on the unchanged mesh, then applied in
+//!    queue order; a fill that touches a tet carved earlier in the batch (its tets or the tets
+//!    across its shell) waits for the next batch, and a triangle without such a fill takes the
+//!    serial path of steps 3–4 on the mesh as it is then. The batch does not depend on the
+//!    number of threads, so neither does the result.
 //! 5. **Labels** by flood fill: tets connected without crossing a surface triangle form a
 //!    region; the side labels of the surface triangles around it name it (`sides = [back,
 //!    front]`), so interfaces get the right label on each side. Tets of region 0 (the outside)
