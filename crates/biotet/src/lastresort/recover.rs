@@ -31,6 +31,14 @@
 //!    tried again, up to [`RecoverOptions::max_grow`] times or [`RecoverOptions::max_cavity_tets`]
 //!    tets; a triangle whose cavity still fails moves to the back of the queue. The queue stops
 //!    when every remaining triangle failed since the last success.
+//!
+//!    **Batches.** The queue is taken 64 triangles at a time (no two sharing a corner:
+//!    they would carve the same tets). Their crossed-tets fills (the first two cavities of step
+//!    3, nearly every call) are searched in parallel on the unchanged mesh, then applied in
+//!    queue order; a fill that touches a tet carved earlier in the batch (its tets or the tets
+//!    across its shell) waits for the next batch, and a triangle without such a fill takes the
+//!    serial path of steps 3–4 on the mesh as it is then. The batch does not depend on the
+//!    number of threads, so neither does the result.
 //! 5. **Labels** by flood fill: tets connected without crossing a surface triangle form a
 //!    region; the side labels of the surface triangles around it name it (`sides = [back,
 //!    front]`), so interfaces get the right label on each side. Tets of region 0 (the outside)
@@ -55,16 +63,20 @@
 use super::cells::Cells;
 use super::search::{SearchError, SearchOptions, Searcher, bbox, boxes_apart};
 use crate::delaunay::Delaunay;
+// The filtered orient3d: the exact predicate's answer, faster.
+use crate::geom::filter::orient3d;
 use crate::geom::intersect::{TriTri, tri_tri};
-use crate::geom::predicates::{Sign, in_exact_range, orient3d};
+use crate::geom::predicates::{Sign, in_exact_range};
 use crate::mesh::coord_key;
 use crate::mesh::surface::SurfaceMesh;
 use crate::mesh::tet::{NO_NEIGHBOR, TET_FACES, TetMesh, sorted3};
 use crate::quality::tri::min_angle_3d_deg;
+use rayon::prelude::*;
 use rustc_hash::{FxHashMap, FxHashSet};
 use serde::Serialize;
 use std::cell::Cell;
 use std::collections::VecDeque;
+use std::sync::Mutex;
 use std::time::Instant;
 use thiserror::Error;
 
@@ -264,19 +276,28 @@ fn recover_checked(
     drop(at);
 
     let mut r = Recovery::new(mesh, surface, tri_map, *opts);
+    r.scan_present();
     let missing_before = r.count_missing();
     let domain = r.cover()?;
+    if domain != Domain::Convex {
+        // Tets put back may hold surface triangles.
+        r.scan_present();
+    }
     r.run();
     if opts.allow_interior_steiner {
         r.run_steiner();
     }
     r.compact();
+    // Also sets the final `is_present`.
     let (removed, conflicts) = r.relabel();
 
     let mut unrecovered = Vec::new();
     for (s, m) in r.tri_map.iter().enumerate() {
-        let present = m.is_some_and(|v| r.present(v));
-        if !present {
+        debug_assert_eq!(
+            r.is_present[s],
+            m.is_some_and(|v| r.view().present(&r.work, v))
+        );
+        if !r.is_present[s] {
             let corners = surface.corners(s);
             unrecovered.push(Unrecovered {
                 triangle: s,
@@ -392,25 +413,31 @@ struct Recovery<'a> {
     opts: RecoverOptions,
     /// Surface triangles in mesh point numbers (`None`: a corner is no mesh point).
     tri_map: Vec<Option<[u32; 3]>>,
+    /// Mapped surface triangles by sorted corners (the last of equal ones) ...
+    face_tri: FxHashMap<[u32; 3], u32>,
+    /// ... and the previous triangle with the same corners (`NO_NEIGHBOR`: none).
+    same_face: Vec<u32>,
+    /// Which surface triangles are faces of live tets: set by [`Self::scan_present`], then kept
+    /// by [`Self::insert`] (carving never removes a present triangle: it is kept as a shell
+    /// face or refilled as a constrained one).
+    is_present: Vec<bool>,
     alive: Vec<bool>,
     free: Vec<u32>,
     /// A live tet at each point (`NO_NEIGHBOR` for none): stars are walked from it across the
     /// adjacency, instead of keeping a list per point (a third of recovery's memory).
     vtet: Vec<u32>,
-    /// Stamps of the star walks, and the buffer of [`Self::with_star`].
-    star_mark: Vec<Cell<u32>>,
-    star_stamp: Cell<u32>,
-    star_buf: Cell<Vec<u32>>,
     /// Surface triangles at each mesh point `x`: `surf_list[surf_start[x]..surf_start[x + 1]]`
     /// (flat: most points are interior and have none).
     surf_start: Vec<u32>,
     surf_list: Vec<u32>,
-    tet_mark: Vec<u32>,
-    pt_mark: Vec<u32>,
-    pt_local: Vec<u32>,
-    stamp: u32,
-    searcher: Searcher,
-    cells: Cells,
+    /// The serial path's scratch.
+    work: Work,
+    /// Tets carved in the current batch (equal to `batch`): later fills of the batch that touch
+    /// them were computed on a stale mesh.
+    claim: Vec<u32>,
+    batch: u32,
+    /// Points at corners of the current batch's triangles (equal to `batch`).
+    picked: Vec<u32>,
     reason: FxHashMap<u32, String>,
     call_ms: Vec<f64>,
     call_nodes: Vec<u64>,
@@ -421,6 +448,75 @@ struct Recovery<'a> {
     grown: usize,
     points_added: usize,
 }
+
+/// Stamped marks and buffers of the read-only stages (walks, carving, searches): one for the
+/// serial path and one per thread for the batches. Results never depend on what a scratch held
+/// before (fresh stamps).
+#[derive(Default)]
+struct Work {
+    tet_mark: Vec<u32>,
+    /// Stamps of the star walks, and the buffer of [`View::with_star`].
+    star_mark: Vec<Cell<u32>>,
+    star_stamp: Cell<u32>,
+    star_buf: Cell<Vec<u32>>,
+    /// Cached sides of points of the plane of the triangle whose crossed tets are walked.
+    side_mark: Vec<u32>,
+    side: Vec<Sign>,
+    /// The stack of that walk.
+    walk_buf: Vec<u32>,
+    pt_mark: Vec<u32>,
+    pt_local: Vec<u32>,
+    stamp: u32,
+    /// Buffers of [`View::carve`] and [`View::fill_cells`].
+    keys: Vec<[u32; 3]>,
+    cell: Vec<u32>,
+    faces: Vec<[u32; 3]>,
+    on_face: Vec<bool>,
+    inner: Vec<u32>,
+    searcher: Searcher,
+    cells: Cells,
+}
+
+impl Work {
+    /// Grow the per-tet and per-point marks to `tets` and `points` (new entries unmarked).
+    fn fit(&mut self, tets: usize, points: usize) {
+        if self.tet_mark.len() < tets {
+            self.tet_mark.resize(tets, 0);
+            self.star_mark.resize(tets, Cell::new(0));
+        }
+        if self.pt_mark.len() < points {
+            self.pt_mark.resize(points, 0);
+            self.pt_local.resize(points, 0);
+            self.side_mark.resize(points, 0);
+            self.side.resize(points, Sign::Zero);
+        }
+    }
+}
+
+/// The read-only part of the recovery, shared by the threads of a batch.
+#[derive(Clone, Copy)]
+struct View<'r> {
+    mesh: &'r TetMesh,
+    tri_map: &'r [Option<[u32; 3]>],
+    vtet: &'r [u32],
+    surf_start: &'r [u32],
+    surf_list: &'r [u32],
+    opts: &'r RecoverOptions,
+    face_tri: &'r FxHashMap<[u32; 3], u32>,
+}
+
+/// A fill of a triangle's crossed tets found on a batch's view, applied later if nothing it
+/// read changed meanwhile.
+struct Speculative {
+    cav: Cavity,
+    new_tets: Vec<[u32; 4]>,
+    /// Time, search nodes and cavity size of each call.
+    calls: Vec<(f64, u64, usize)>,
+}
+
+/// Missing triangles tried at once on one view; fixed, so the result does not depend on the
+/// number of threads.
+const BATCH: usize = 64;
 
 /// A carved cavity ready to fill.
 #[derive(Default)]
@@ -472,6 +568,532 @@ impl Failure {
     }
 }
 
+impl View<'_> {
+    /// The surface triangles (one of equal ones) that are faces of tet `t`.
+    fn faces_on_surface(&self, t: usize) -> [Option<u32>; 4] {
+        let tv = self.mesh.tets[t];
+        let on = tv.map(|x| self.surf_start[x as usize] != self.surf_start[x as usize + 1]);
+        let mut out = [None; 4];
+        for (f, g) in TET_FACES.iter().enumerate() {
+            if on[g[0]] && on[g[1]] && on[g[2]] {
+                out[f] = self.face_tri.get(&sorted3(self.mesh.face(t, f))).copied();
+            }
+        }
+        out
+    }
+
+    /// The live tets with corner `v` (into `out`, in walk order).
+    fn star_into(&self, w: &Work, v: u32, out: &mut Vec<u32>) {
+        out.clear();
+        let t0 = self.vtet[v as usize];
+        if t0 == NO_NEIGHBOR {
+            return;
+        }
+        let st = w.star_stamp.get().wrapping_add(1);
+        w.star_stamp.set(st);
+        w.star_mark[t0 as usize].set(st);
+        out.push(t0);
+        let mut i = 0;
+        while i < out.len() {
+            let t = out[i] as usize;
+            i += 1;
+            let tv = self.mesh.tets[t];
+            for (&x, &n) in tv.iter().zip(&self.mesh.neighbors[t]) {
+                // The faces holding v are those opposite the other corners.
+                if x != v && n != NO_NEIGHBOR && w.star_mark[n as usize].get() != st {
+                    w.star_mark[n as usize].set(st);
+                    out.push(n);
+                }
+            }
+        }
+    }
+
+    /// The live tets with corner `v`, sorted.
+    fn star(&self, w: &Work, v: u32) -> Vec<u32> {
+        let mut out = Vec::new();
+        self.star_into(w, v, &mut out);
+        out.sort_unstable();
+        out
+    }
+
+    /// `f` of the live tets with corner `v` (in walk order), without allocating.
+    fn with_star<R>(&self, w: &Work, v: u32, f: impl FnOnce(&[u32]) -> R) -> R {
+        let mut buf = w.star_buf.take();
+        self.star_into(w, v, &mut buf);
+        let r = f(&buf);
+        w.star_buf.set(buf);
+        r
+    }
+
+    /// Is the triangle a face of a live tet?
+    fn present(&self, w: &Work, v: [u32; 3]) -> bool {
+        self.with_star(w, v[0], |star| {
+            star.iter().any(|&t| {
+                let tv = self.mesh.tets[t as usize];
+                tv.contains(&v[1]) && tv.contains(&v[2])
+            })
+        })
+    }
+
+    /// The tets that the missing triangle `v` crosses: those with a face meeting it other than
+    /// in shared corners or edges (exact), found by walking from its corners across such faces.
+    /// Refilling just these recovers most triangles at a fraction of the cost of the corners'
+    /// cavity (a few tets instead of dozens). `None` when there are more than
+    /// [`CROSSED_MAX_TETS`].
+    fn crossed_tets(&self, w: &mut Work, v: [u32; 3]) -> Option<Vec<u32>> {
+        let tp = v.map(|x| self.mesh.points[x as usize]);
+        let (lo, hi) = bbox(&tp);
+        w.stamp += 1;
+        let st = w.stamp;
+        let mut out = Vec::new();
+        let mut stack = std::mem::take(&mut w.walk_buf);
+        let mut star = w.star_buf.take();
+        stack.clear();
+        for &c in &v {
+            self.star_into(w, c, &mut star);
+            for &t in &star {
+                if w.tet_mark[t as usize] != st {
+                    w.tet_mark[t as usize] = st;
+                    stack.push(t);
+                }
+            }
+        }
+        w.star_buf.set(star);
+        while let Some(t) = stack.pop() {
+            let mut crossed = false;
+            let tv = self.mesh.tets[t as usize];
+            // Each corner's side of the plane of `v` (exact, once per point and walk).
+            let side = tv.map(|x| self.side_of(w, x, &tp, st));
+            for (f, face) in TET_FACES.iter().enumerate() {
+                // A face with its corners off the plane on one side, or on it only at corners of
+                // `v`, meets `v` at most in shared corners or a shared edge: `tri_tri` would not
+                // call it improper (same answer, without its tests).
+                let mut pos = false;
+                let mut neg = false;
+                let mut stray = false;
+                for &k in face {
+                    match side[k] {
+                        Sign::Positive => pos = true,
+                        Sign::Negative => neg = true,
+                        Sign::Zero => stray |= !v.contains(&tv[k]),
+                    }
+                }
+                if !stray && pos != neg {
+                    continue;
+                }
+                let g = self.mesh.face(t as usize, f);
+                let gp = g.map(|x| self.mesh.points[x as usize]);
+                let (glo, ghi) = bbox(&gp);
+                if boxes_apart(glo, ghi, lo, hi) {
+                    continue;
+                }
+                if tri_tri(&tp, &gp) != TriTri::Improper {
+                    continue;
+                }
+                crossed = true;
+                let n = self.mesh.neighbors[t as usize][f];
+                if n != NO_NEIGHBOR && w.tet_mark[n as usize] != st {
+                    w.tet_mark[n as usize] = st;
+                    stack.push(n);
+                }
+            }
+            if crossed {
+                out.push(t);
+                if out.len() > CROSSED_MAX_TETS {
+                    w.walk_buf = stack;
+                    return None;
+                }
+            }
+        }
+        w.walk_buf = stack;
+        if out.is_empty() {
+            return None;
+        }
+        out.sort_unstable();
+        Some(out)
+    }
+
+    /// The side of point `x` of the plane through `tp` (exact), cached for stamp `st`.
+    fn side_of(&self, w: &mut Work, x: u32, tp: &[P3; 3], st: u32) -> Sign {
+        let i = x as usize;
+        if w.side_mark[i] != st {
+            w.side_mark[i] = st;
+            w.side[i] = orient3d(tp[0], tp[1], tp[2], self.mesh.points[i]);
+        }
+        w.side[i]
+    }
+
+    /// Add the next ring: every tet across a face of the cavity.
+    fn grow(&self, w: &mut Work, tets: &mut Vec<u32>) {
+        w.stamp += 1;
+        let st = w.stamp;
+        for &t in tets.iter() {
+            w.tet_mark[t as usize] = st;
+        }
+        let n = tets.len();
+        for i in 0..n {
+            for &nb in &self.mesh.neighbors[tets[i] as usize] {
+                if nb != NO_NEIGHBOR && w.tet_mark[nb as usize] != st {
+                    w.tet_mark[nb as usize] = st;
+                    tets.push(nb);
+                }
+            }
+        }
+    }
+
+    fn carve(
+        &self,
+        w: &mut Work,
+        m: [u32; 3],
+        tets: &[u32],
+        cav: &mut Cavity,
+    ) -> Result<(), Failure> {
+        w.stamp += 1;
+        let st = w.stamp;
+        for &t in tets {
+            w.tet_mark[t as usize] = st;
+        }
+        cav.tets.extend_from_slice(tets);
+        for &t in &cav.tets {
+            for &x in &self.mesh.tets[t as usize] {
+                if w.pt_mark[x as usize] != st {
+                    w.pt_mark[x as usize] = st;
+                    w.pt_local[x as usize] = cav.points.len() as u32;
+                    cav.points.push(x);
+                    cav.coords.push(self.mesh.points[x as usize]);
+                }
+            }
+        }
+        let mut shell_keys = std::mem::take(&mut w.keys);
+        shell_keys.clear();
+        for &t in &cav.tets {
+            for f in 0..4 {
+                let n = self.mesh.neighbors[t as usize][f];
+                if n == NO_NEIGHBOR || w.tet_mark[n as usize] != st {
+                    let g = self.mesh.face(t as usize, f);
+                    let nf = if n == NO_NEIGHBOR {
+                        0
+                    } else {
+                        self.mesh.neighbors[n as usize]
+                            .iter()
+                            .position(|&x| x == t)
+                            .unwrap_or(0) as u8
+                    };
+                    cav.shell.push((g, n, nf));
+                    shell_keys.push(sorted3(g));
+                    let l = g.map(|x| w.pt_local[x as usize]);
+                    cav.half.push([l[0], l[2], l[1]]);
+                }
+            }
+        }
+        // Constrained faces.
+        shell_keys.sort_unstable();
+        let r = self.constrain(w, m, cav, st, &shell_keys);
+        w.keys = shell_keys;
+        r
+    }
+
+    /// The constrained faces of a carved cavity (`shell_keys`: its shell faces, sorted).
+    fn constrain(
+        &self,
+        w: &mut Work,
+        m: [u32; 3],
+        cav: &mut Cavity,
+        st: u32,
+        shell_keys: &[[u32; 3]],
+    ) -> Result<(), Failure> {
+        let mut dropped = Vec::new();
+        let mut found_m = false;
+        let mkey = sorted3(m);
+        for &x in &cav.points {
+            let (a, b) = (self.surf_start[x as usize], self.surf_start[x as usize + 1]);
+            for &s in &self.surf_list[a as usize..b as usize] {
+                let Some(v) = self.tri_map[s as usize] else {
+                    continue;
+                };
+                if v.iter().any(|&y| w.pt_mark[y as usize] != st) {
+                    continue;
+                }
+                // Once, at its first corner in the cavity's order.
+                if v.iter()
+                    .any(|&y| w.pt_local[y as usize] < w.pt_local[x as usize])
+                {
+                    continue;
+                }
+                let key = sorted3(v);
+                if shell_keys.binary_search(&key).is_ok() {
+                    continue;
+                }
+                let place = if self.interior_face(w, v, cav, st) {
+                    Place::Inside
+                } else {
+                    self.inside_cavity(w, v, cav, st)
+                };
+                let l = v.map(|y| w.pt_local[y as usize]);
+                match place {
+                    Place::Outside => {
+                        if key == mkey {
+                            return Err(Failure::NotInside);
+                        }
+                        continue;
+                    }
+                    Place::Inside => {
+                        cav.half.push(l);
+                        cav.half.push([l[0], l[2], l[1]]);
+                    }
+                    Place::OnBoundary { faces, inward } => {
+                        dropped.resize(cav.shell.len(), false);
+                        for k in faces {
+                            dropped[k] = true;
+                        }
+                        cav.half.push(if inward { l } else { [l[0], l[2], l[1]] });
+                    }
+                }
+                if key == mkey {
+                    found_m = true;
+                }
+            }
+        }
+        if !dropped.is_empty() {
+            // Boundary faces re-triangulated by surface triangles in their plane.
+            let mut i = 0;
+            cav.half.retain(|_| {
+                i += 1;
+                dropped.get(i - 1).is_none_or(|&d| !d)
+            });
+        }
+        if !found_m {
+            return Err(Failure::NotInside);
+        }
+        Ok(())
+    }
+
+    /// Is `v` a face between two tets of the cavity?
+    fn interior_face(&self, w: &Work, v: [u32; 3], cav: &Cavity, st: u32) -> bool {
+        if cav.tets.len() <= 16 {
+            // A face is in at most two tets: two carved ones leave none outside.
+            let holds = |&t: &u32| {
+                let tv = self.mesh.tets[t as usize];
+                v.iter().all(|x| tv.contains(x))
+            };
+            return cav.tets.iter().filter(|t| holds(t)).count() == 2;
+        }
+        self.with_star(w, v[0], |star| {
+            let mut n = 0;
+            for &t in star {
+                let tv = self.mesh.tets[t as usize];
+                if tv.contains(&v[1]) && tv.contains(&v[2]) {
+                    if w.tet_mark[t as usize] != st {
+                        return false;
+                    }
+                    n += 1;
+                }
+            }
+            n == 2
+        })
+    }
+
+    /// Does triangle `v` (corners in the cavity) lie inside the cavity? Exact: no improper
+    /// contact with any shell face, so its open part is entirely inside or entirely outside;
+    /// then the point `x = u + ε(w − u) + δ(v − u)` (0 < δ ≪ ε infinitesimal, inside the
+    /// triangle next to corner `u`) is located in the carved tets at `u`. The orientation of `x`
+    /// against a plane is the first non-zero of its orientations of `u`, `w`, `v`.
+    ///
+    /// A triangle in the plane of mesh boundary faces of the cavity (a surface triangle on the
+    /// convex hull, split differently) is [`Place::OnBoundary`]: those faces are replaced by it.
+    fn inside_cavity(&self, w: &Work, v: [u32; 3], cav: &Cavity, st: u32) -> Place {
+        let tp = v.map(|x| self.mesh.points[x as usize]);
+        let (lo, hi) = bbox(&tp);
+        let mut on_boundary = Vec::new();
+        for (i, (g, n, _)) in cav.shell.iter().enumerate() {
+            let gp = g.map(|x| self.mesh.points[x as usize]);
+            if (0..3).any(|k| gp.iter().all(|p| p[k] < lo[k]) || gp.iter().all(|p| p[k] > hi[k])) {
+                continue;
+            }
+            if tri_tri(&tp, &gp) == TriTri::Improper {
+                let coplanar = tp
+                    .iter()
+                    .all(|&p| orient3d(gp[0], gp[1], gp[2], p) == Sign::Zero);
+                if *n == NO_NEIGHBOR && coplanar {
+                    on_boundary.push(i);
+                    continue;
+                }
+                return Place::Outside;
+            }
+        }
+        if let Some(&i) = on_boundary.first() {
+            // Orient it like the boundary faces seen from inside: towards the cavity tet's apex.
+            let g = cav.shell[i].0;
+            let apex = cav.tets.iter().find_map(|&t| {
+                let tv = self.mesh.tets[t as usize];
+                let inside = g.iter().all(|x| tv.contains(x));
+                inside.then(|| tv.into_iter().find(|x| !g.contains(x)))?
+            });
+            let Some(apex) = apex else {
+                return Place::Outside;
+            };
+            let inward =
+                orient3d(tp[0], tp[1], tp[2], self.mesh.points[apex as usize]) == Sign::Positive;
+            return Place::OnBoundary {
+                faces: on_boundary,
+                inward,
+            };
+        }
+        let [u, vv, ww] = tp;
+        // Any carved tet at u holding the symbolic point answers: no order, no allocation.
+        let inside = self.with_star(w, v[0], |star| {
+            star.iter().any(|&t| {
+                w.tet_mark[t as usize] == st && {
+                    let c = self.mesh.corners(t as usize);
+                    TET_FACES.iter().all(|f| {
+                        let (a, b, cc) = (c[f[0]], c[f[1]], c[f[2]]);
+                        let mut s = orient3d(a, b, cc, u);
+                        if s == Sign::Zero {
+                            s = orient3d(a, b, cc, ww);
+                        }
+                        if s == Sign::Zero {
+                            s = orient3d(a, b, cc, vv);
+                        }
+                        s != Sign::Positive
+                    })
+                }
+            })
+        });
+        if inside {
+            Place::Inside
+        } else {
+            Place::Outside
+        }
+    }
+
+    /// Split into cells and search each; the new tets in global numbering.
+    fn fill_cells(
+        &self,
+        w: &mut Work,
+        cav: &mut Cavity,
+        nodes: &mut u64,
+    ) -> Result<Vec<[u32; 4]>, Failure> {
+        let mut cell = std::mem::take(&mut w.cell);
+        let mut faces = std::mem::take(&mut w.faces);
+        let mut inner = std::mem::take(&mut w.inner);
+        let r = self.fill_cells_with(w, cav, nodes, &mut cell, &mut faces, &mut inner);
+        w.cell = cell;
+        w.faces = faces;
+        w.inner = inner;
+        r
+    }
+
+    /// [`Self::fill_cells`] with its buffers.
+    fn fill_cells_with(
+        &self,
+        w: &mut Work,
+        cav: &mut Cavity,
+        nodes: &mut u64,
+        cell: &mut Vec<u32>,
+        faces: &mut Vec<[u32; 3]>,
+        inner: &mut Vec<u32>,
+    ) -> Result<Vec<[u32; 4]>, Failure> {
+        cell.clear();
+        let n = w
+            .cells
+            .split(&cav.coords, &cav.half, cell)
+            .map_err(|_| Failure::Cells)?;
+        let on_face = &mut w.on_face;
+        on_face.clear();
+        on_face.resize(cav.points.len(), false);
+        for f in &cav.half {
+            for &x in f {
+                on_face[x as usize] = true;
+            }
+        }
+        inner.clear();
+        inner.extend((0..cav.points.len() as u32).filter(|&x| !on_face[x as usize]));
+        let mut out = Vec::new();
+        for c in 0..n as u32 {
+            faces.clear();
+            faces.extend(
+                cav.half
+                    .iter()
+                    .zip(cell.iter())
+                    .filter(|(_, k)| **k == c)
+                    .map(|(f, _)| *f),
+            );
+            // A first, cheaper try among better tets only (ηe raised): fewer candidates, and
+            // fewer slivers for the sliver removal that follows; the configured search if not.
+            let mut first = None;
+            if self.opts.first_quality > self.opts.search.min_quality {
+                let o = SearchOptions {
+                    min_quality: self.opts.first_quality,
+                    max_nodes: self.opts.search.max_nodes.min(FIRST_TRY_NODES),
+                    ..self.opts.search
+                };
+                match w.searcher.fill(&cav.coords, faces, inner, &o) {
+                    Ok(f) => first = Some(f),
+                    Err(e) => *nodes += nodes_of(&e),
+                }
+            }
+            let result = match first {
+                Some(f) => Ok(f),
+                None => w
+                    .searcher
+                    .fill(&cav.coords, faces, inner, &self.opts.search),
+            };
+            match result {
+                Ok(f) => {
+                    *nodes += f.nodes_visited;
+                    out.extend(f.tets.iter().map(|t| t.map(|x| cav.points[x as usize])));
+                }
+                Err(e) => {
+                    *nodes += nodes_of(&e);
+                    return Err(Failure::Search(e));
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// Carve `tets` and fill the cavity (not inserted); the call's time, nodes and size are
+    /// pushed to `calls`.
+    fn carve_fill(
+        &self,
+        w: &mut Work,
+        m: [u32; 3],
+        tets: &[u32],
+        calls: &mut Vec<(f64, u64, usize)>,
+    ) -> Result<(Cavity, Vec<[u32; 4]>), Failure> {
+        let start = Instant::now();
+        let mut nodes = 0u64;
+        let mut cav = Cavity::default();
+        let r = self
+            .carve(w, m, tets, &mut cav)
+            .and_then(|()| self.fill_cells(w, &mut cav, &mut nodes));
+        calls.push((start.elapsed().as_secs_f64() * 1e3, nodes, cav.tets.len()));
+        r.map(|t| (cav, t))
+    }
+
+    /// The crossed-tets stage of [`Recovery::attempt`] (the tets `v` crosses, then those and
+    /// their face neighbours), without inserting; `None` when neither fills.
+    fn try_crossed(&self, w: &mut Work, v: [u32; 3]) -> Option<Speculative> {
+        let crossed = self.crossed_tets(w, v)?;
+        let mut calls = Vec::new();
+        if let Ok((cav, new_tets)) = self.carve_fill(w, v, &crossed, &mut calls) {
+            return Some(Speculative {
+                cav,
+                new_tets,
+                calls,
+            });
+        }
+        let mut ring = crossed;
+        self.grow(w, &mut ring);
+        let (cav, new_tets) = self.carve_fill(w, v, &ring, &mut calls).ok()?;
+        Some(Speculative {
+            cav,
+            new_tets,
+            calls,
+        })
+    }
+}
+
 impl<'a> Recovery<'a> {
     fn new(
         mesh: &'a mut TetMesh,
@@ -500,25 +1122,33 @@ impl<'a> Recovery<'a> {
             }
         }
         drop(fill);
+        let mut face_tri = FxHashMap::default();
+        face_tri.reserve(tri_map.len());
+        let mut same_face = vec![NO_NEIGHBOR; tri_map.len()];
+        for (s, m) in tri_map.iter().enumerate() {
+            if let Some(v) = m
+                && let Some(prev) = face_tri.insert(sorted3(*v), s as u32)
+            {
+                same_face[s] = prev;
+            }
+        }
         let mut r = Recovery {
             mesh,
             surface,
             opts,
             tri_map,
+            face_tri,
+            same_face,
+            is_present: Vec::new(),
             alive: Vec::new(),
             free: Vec::new(),
             vtet: Vec::new(),
-            star_mark: Vec::new(),
-            star_stamp: Cell::new(0),
-            star_buf: Cell::new(Vec::new()),
             surf_start,
             surf_list,
-            tet_mark: Vec::new(),
-            pt_mark: vec![0; np],
-            pt_local: vec![0; np],
-            stamp: 0,
-            searcher: Searcher::new(),
-            cells: Cells::default(),
+            work: Work::default(),
+            claim: Vec::new(),
+            batch: 0,
+            picked: vec![0; np],
             reason: FxHashMap::default(),
             call_ms: Vec::new(),
             call_nodes: Vec::new(),
@@ -538,81 +1168,80 @@ impl<'a> Recovery<'a> {
         let np = self.mesh.points.len();
         self.alive = vec![true; self.mesh.tets.len()];
         self.free.clear();
-        self.tet_mark = vec![0; self.mesh.tets.len()];
+        self.work.tet_mark = vec![0; self.mesh.tets.len()];
+        self.work.star_mark = vec![Cell::new(0); self.mesh.tets.len()];
+        self.work.star_stamp.set(0);
+        self.work.fit(0, np);
+        self.claim = vec![0; self.mesh.tets.len()];
         self.vtet = vec![NO_NEIGHBOR; np];
         for (t, v) in self.mesh.tets.iter().enumerate() {
             for &x in v {
                 self.vtet[x as usize] = t as u32;
             }
         }
-        self.star_mark = vec![Cell::new(0); self.mesh.tets.len()];
-        self.star_stamp.set(0);
     }
 
-    /// The live tets with corner `v` (into `out`, in walk order).
-    fn star_into(&self, v: u32, out: &mut Vec<u32>) {
-        out.clear();
-        let t0 = self.vtet[v as usize];
-        if t0 == NO_NEIGHBOR {
-            return;
-        }
-        let st = self.star_stamp.get().wrapping_add(1);
-        self.star_stamp.set(st);
-        self.star_mark[t0 as usize].set(st);
-        out.push(t0);
-        let mut i = 0;
-        while i < out.len() {
-            let t = out[i] as usize;
-            i += 1;
-            let tv = self.mesh.tets[t];
-            for (&x, &n) in tv.iter().zip(&self.mesh.neighbors[t]) {
-                // The faces holding v are those opposite the other corners.
-                if x != v && n != NO_NEIGHBOR && self.star_mark[n as usize].get() != st {
-                    self.star_mark[n as usize].set(st);
-                    out.push(n);
-                }
-            }
+    fn view(&self) -> View<'_> {
+        View {
+            mesh: self.mesh,
+            tri_map: &self.tri_map,
+            vtet: &self.vtet,
+            surf_start: &self.surf_start,
+            surf_list: &self.surf_list,
+            opts: &self.opts,
+            face_tri: &self.face_tri,
         }
     }
 
-    /// The live tets with corner `v`, sorted.
-    fn star(&self, v: u32) -> Vec<u32> {
-        let mut out = Vec::new();
-        self.star_into(v, &mut out);
-        out.sort_unstable();
-        out
-    }
-
-    /// `f` of the live tets with corner `v` (in walk order), without allocating.
-    fn with_star<R>(&self, v: u32, f: impl FnOnce(&[u32]) -> R) -> R {
-        let mut buf = self.star_buf.take();
-        self.star_into(v, &mut buf);
-        let r = f(&buf);
-        self.star_buf.set(buf);
+    /// `f` on the view with the serial scratch.
+    fn with_work<R>(&mut self, f: impl FnOnce(View<'_>, &mut Work) -> R) -> R {
+        let mut w = std::mem::take(&mut self.work);
+        let r = f(self.view(), &mut w);
+        self.work = w;
         r
     }
 
-    /// Is the triangle a face of a live tet?
-    fn present(&self, v: [u32; 3]) -> bool {
-        self.with_star(v[0], |star| {
-            star.iter().any(|&t| {
-                let tv = self.mesh.tets[t as usize];
-                tv.contains(&v[1]) && tv.contains(&v[2])
-            })
-        })
-    }
-
+    /// Surface triangles missing (by [`Self::is_present`]).
     fn count_missing(&self) -> usize {
-        self.tri_map
-            .iter()
-            .filter(|m| !m.is_some_and(|v| self.present(v)))
-            .count()
+        self.is_present.iter().filter(|&&p| !p).count()
     }
 
     /// The missing triangles whose corners are all mesh points.
     fn missing_mapped(&self) -> impl Iterator<Item = u32> + '_ {
         (0..self.tri_map.len() as u32)
-            .filter(|&s| self.tri_map[s as usize].is_some_and(|v| !self.present(v)))
+            .filter(|&s| self.tri_map[s as usize].is_some() && !self.is_present[s as usize])
+    }
+
+    /// Set [`Self::is_present`] from scratch: one pass over the tets' faces (cheaper than a star
+    /// walk per triangle).
+    fn scan_present(&mut self) {
+        self.is_present.clear();
+        self.is_present.resize(self.tri_map.len(), false);
+        let (view, alive) = (self.view(), &self.alive);
+        let hits: Vec<u32> = (0..self.mesh.tets.len())
+            .into_par_iter()
+            .with_min_len(4096)
+            .filter(|&t| alive[t])
+            .flat_map_iter(|t| view.faces_on_surface(t).into_iter().flatten())
+            .collect();
+        for s in hits {
+            self.mark_chain(s);
+        }
+    }
+
+    /// Mark surface triangle `s` and those with the same corners present.
+    fn mark_chain(&mut self, mut s: u32) {
+        while s != NO_NEIGHBOR {
+            self.is_present[s as usize] = true;
+            s = self.same_face[s as usize];
+        }
+    }
+
+    /// Mark the surface triangles that are faces of tet `t` present.
+    fn mark_present(&mut self, t: usize) {
+        for s in self.view().faces_on_surface(t).into_iter().flatten() {
+            self.mark_chain(s);
+        }
     }
 
     /// Make the mesh cover the convex hull of its points (module docs, step 1).
@@ -656,36 +1285,125 @@ impl<'a> Recovery<'a> {
         Ok(Domain::DelaunayCompleted { tets_added: added })
     }
 
-    /// Process the queue of missing triangles (module docs, steps 3–4).
+    /// Process the queue of missing triangles (module docs, steps 3–4), in batches: the
+    /// crossed-tets fills of [`BATCH`] triangles are searched in parallel on the same mesh, then
+    /// applied in queue order; a fill whose tets or neighbours an earlier one of the batch carved
+    /// waits for the next batch, and a triangle without a crossed-tets fill goes through
+    /// [`Self::attempt`] on the mesh as it is then. The result does not depend on the threads.
     fn run(&mut self) {
         let mut queue: VecDeque<u32> = self.missing_mapped().collect();
+        let threads = rayon::current_num_threads().max(1);
+        let mut pool: Vec<Mutex<Work>> = (0..threads).map(|_| Mutex::default()).collect();
         let mut stalled = 0usize;
-        while let Some(s) = queue.pop_front() {
-            let Some(v) = self.tri_map[s as usize] else {
-                continue;
-            };
-            if self.present(v) {
-                continue;
+        let mut batch: Vec<u32> = Vec::with_capacity(BATCH);
+        let mut wait: Vec<u32> = Vec::new();
+        loop {
+            // Triangles sharing a corner would mostly carve the same tets: one per batch, the
+            // others keep their place in the queue.
+            batch.clear();
+            self.batch += 1;
+            let mut scanned = 0;
+            while batch.len() < BATCH
+                && scanned < 8 * BATCH
+                && let Some(s) = queue.pop_front()
+            {
+                scanned += 1;
+                let Some(v) = self.tri_map[s as usize] else {
+                    continue;
+                };
+                if self.is_present[s as usize] {
+                    continue;
+                }
+                if v.iter().any(|&x| self.picked[x as usize] == self.batch) {
+                    wait.push(s);
+                    continue;
+                }
+                for &x in &v {
+                    self.picked[x as usize] = self.batch;
+                }
+                batch.push(s);
             }
-            if stalled > queue.len() {
+            for &s in wait.iter().rev() {
                 queue.push_front(s);
+            }
+            wait.clear();
+            if batch.is_empty() {
                 break;
             }
-            if self.attempt(s, v, None) {
-                stalled = 0;
-                self.reason.remove(&s);
-            } else {
-                stalled += 1;
-                queue.push_back(s);
+            let (nt, np) = (self.mesh.tets.len(), self.mesh.points.len());
+            for w in &mut pool {
+                w.get_mut().unwrap_or_else(|e| e.into_inner()).fit(nt, np);
             }
+            let view = self.view();
+            let found: Vec<Option<Speculative>> = batch
+                .par_iter()
+                .map(|&s| {
+                    let v = view.tri_map[s as usize]?;
+                    let k = rayon::current_thread_index().unwrap_or(0) % pool.len();
+                    let mut w = pool[k].lock().unwrap_or_else(|e| e.into_inner());
+                    view.try_crossed(&mut w, v)
+                })
+                .collect();
+            for (i, (&s, found)) in batch.iter().zip(found).enumerate() {
+                let Some(v) = self.tri_map[s as usize] else {
+                    continue;
+                };
+                if self.is_present[s as usize] {
+                    continue;
+                }
+                // Every triangle left failed since the last success.
+                if stalled > queue.len() + wait.len() + (batch.len() - i - 1) {
+                    return;
+                }
+                match found {
+                    Some(f) if !self.stale(&f.cav) => {
+                        for &(ms, nodes, size) in &f.calls {
+                            self.call_ms.push(ms);
+                            self.call_nodes.push(nodes);
+                            self.call_sizes.push(size);
+                        }
+                        self.crossed_tried += 1;
+                        self.crossed_ok += 1;
+                        self.calls_ok += 1;
+                        self.insert(&f.cav, &f.new_tets);
+                        stalled = 0;
+                        self.reason.remove(&s);
+                    }
+                    Some(_) => wait.push(s),
+                    None => {
+                        if self.attempt(s, v, None) {
+                            stalled = 0;
+                            self.reason.remove(&s);
+                        } else {
+                            stalled += 1;
+                            queue.push_back(s);
+                        }
+                    }
+                }
+            }
+            for &s in wait.iter().rev() {
+                queue.push_front(s);
+            }
+            wait.clear();
         }
+    }
+
+    /// Whether a fill found on the batch's view touches a tet carved since (its tets or the
+    /// kept tets across its shell).
+    fn stale(&self, cav: &Cavity) -> bool {
+        let b = self.batch;
+        cav.tets.iter().any(|&t| self.claim[t as usize] == b)
+            || cav
+                .shell
+                .iter()
+                .any(|&(_, n, _)| n != NO_NEIGHBOR && self.claim[n as usize] == b)
     }
 
     /// One triangle: first the smallest cavity (the tets it crosses), then the cavity of its
     /// corners, grown on failure.
     fn attempt(&mut self, s: u32, v: [u32; 3], steiner: Option<()>) -> bool {
         if steiner.is_none()
-            && let Some(crossed) = self.crossed_tets(v)
+            && let Some(crossed) = self.with_work(|view, w| view.crossed_tets(w, v))
         {
             self.crossed_tried += 1;
             if self.carve_and_fill(v, &crossed, false).is_ok() {
@@ -695,28 +1413,31 @@ impl<'a> Recovery<'a> {
             // Then those and their face neighbours: still far smaller than the corners' cavity,
             // and on brain_20k it recovers all but 2 of the triangles the crossed tets miss.
             let mut ring = crossed;
-            self.grow(&mut ring);
+            self.with_work(|view, w| view.grow(w, &mut ring));
             if self.carve_and_fill(v, &ring, false).is_ok() {
                 self.crossed_ok += 1;
                 return true;
             }
         }
         // The tets around the corners.
-        self.stamp += 1;
-        let st = self.stamp;
-        let mut tets = Vec::new();
-        for &c in &v {
-            for t in self.star(c) {
-                if self.tet_mark[t as usize] != st {
-                    self.tet_mark[t as usize] = st;
-                    tets.push(t);
+        let mut tets = self.with_work(|view, w| {
+            w.stamp += 1;
+            let st = w.stamp;
+            let mut tets = Vec::new();
+            for &c in &v {
+                for t in view.star(w, c) {
+                    if w.tet_mark[t as usize] != st {
+                        w.tet_mark[t as usize] = st;
+                        tets.push(t);
+                    }
                 }
             }
-        }
+            tets
+        });
         for ring in 0..=self.opts.max_grow {
             if ring > 0 {
                 self.grown += 1;
-                self.grow(&mut tets);
+                self.with_work(|view, w| view.grow(w, &mut tets));
             }
             if tets.len() > self.opts.max_cavity_tets {
                 self.reason.insert(s, Failure::TooLarge.describe());
@@ -732,86 +1453,18 @@ impl<'a> Recovery<'a> {
         false
     }
 
-    /// The tets that the missing triangle `v` crosses: those with a face meeting it other than
-    /// in shared corners or edges (exact), found by walking from its corners across such faces.
-    /// Refilling just these recovers most triangles at a fraction of the cost of the corners'
-    /// cavity (a few tets instead of dozens). `None` when there are more than
-    /// [`CROSSED_MAX_TETS`].
-    fn crossed_tets(&mut self, v: [u32; 3]) -> Option<Vec<u32>> {
-        let tp = v.map(|x| self.mesh.points[x as usize]);
-        let (lo, hi) = bbox(&tp);
-        self.stamp += 1;
-        let st = self.stamp;
-        let mut out = Vec::new();
-        let mut stack: Vec<u32> = Vec::new();
-        for &c in &v {
-            for t in self.star(c) {
-                if self.tet_mark[t as usize] != st {
-                    self.tet_mark[t as usize] = st;
-                    stack.push(t);
-                }
-            }
-        }
-        while let Some(t) = stack.pop() {
-            let mut crossed = false;
-            for f in 0..4 {
-                let g = self.mesh.face(t as usize, f);
-                let gp = g.map(|x| self.mesh.points[x as usize]);
-                let (glo, ghi) = bbox(&gp);
-                if boxes_apart(glo, ghi, lo, hi) {
-                    continue;
-                }
-                if tri_tri(&tp, &gp) != TriTri::Improper {
-                    continue;
-                }
-                crossed = true;
-                let n = self.mesh.neighbors[t as usize][f];
-                if n != NO_NEIGHBOR && self.tet_mark[n as usize] != st {
-                    self.tet_mark[n as usize] = st;
-                    stack.push(n);
-                }
-            }
-            if crossed {
-                out.push(t);
-                if out.len() > CROSSED_MAX_TETS {
-                    return None;
-                }
-            }
-        }
-        if out.is_empty() {
-            return None;
-        }
-        out.sort_unstable();
-        Some(out)
-    }
-
-    /// Add the next ring: every tet across a face of the cavity.
-    fn grow(&mut self, tets: &mut Vec<u32>) {
-        self.stamp += 1;
-        let st = self.stamp;
-        for &t in tets.iter() {
-            self.tet_mark[t as usize] = st;
-        }
-        let n = tets.len();
-        for i in 0..n {
-            for &nb in &self.mesh.neighbors[tets[i] as usize] {
-                if nb != NO_NEIGHBOR && self.tet_mark[nb as usize] != st {
-                    self.tet_mark[nb as usize] = st;
-                    tets.push(nb);
-                }
-            }
-        }
-    }
-
     /// Carve the tets `tets`, fill the cavity, and insert the fill.
     fn carve_and_fill(&mut self, m: [u32; 3], tets: &[u32], steiner: bool) -> Result<(), Failure> {
         let start = Instant::now();
         let mut nodes = 0u64;
         let n0 = self.mesh.points.len();
         let mut cav = Cavity::default();
-        let result = self
-            .carve(m, tets, &mut cav, steiner)
-            .and_then(|()| self.fill_cells(&mut cav, &mut nodes));
+        let mut result = self.with_work(|view, w| view.carve(w, m, tets, &mut cav));
+        if steiner && result.is_ok() {
+            result = self.add_steiner(&mut cav);
+        }
+        let result = result
+            .and_then(|()| self.with_work(|view, w| view.fill_cells(w, &mut cav, &mut nodes)));
         let ok = match result {
             Ok(new_tets) => {
                 self.insert(&cav, &new_tets);
@@ -827,268 +1480,6 @@ impl<'a> Recovery<'a> {
         self.call_nodes.push(nodes);
         self.call_sizes.push(cav.tets.len());
         ok
-    }
-
-    fn carve(
-        &mut self,
-        m: [u32; 3],
-        tets: &[u32],
-        cav: &mut Cavity,
-        steiner: bool,
-    ) -> Result<(), Failure> {
-        self.stamp += 1;
-        let st = self.stamp;
-        for &t in tets {
-            self.tet_mark[t as usize] = st;
-        }
-        cav.tets.extend_from_slice(tets);
-        for &t in &cav.tets {
-            for &x in &self.mesh.tets[t as usize] {
-                if self.pt_mark[x as usize] != st {
-                    self.pt_mark[x as usize] = st;
-                    self.pt_local[x as usize] = cav.points.len() as u32;
-                    cav.points.push(x);
-                    cav.coords.push(self.mesh.points[x as usize]);
-                }
-            }
-        }
-        let mut shell_keys: FxHashSet<[u32; 3]> = FxHashSet::default();
-        for &t in &cav.tets {
-            for f in 0..4 {
-                let n = self.mesh.neighbors[t as usize][f];
-                if n == NO_NEIGHBOR || self.tet_mark[n as usize] != st {
-                    let g = self.mesh.face(t as usize, f);
-                    let nf = if n == NO_NEIGHBOR {
-                        0
-                    } else {
-                        self.mesh.neighbors[n as usize]
-                            .iter()
-                            .position(|&x| x == t)
-                            .unwrap_or(0) as u8
-                    };
-                    cav.shell.push((g, n, nf));
-                    shell_keys.insert(sorted3(g));
-                    let l = g.map(|x| self.pt_local[x as usize]);
-                    cav.half.push([l[0], l[2], l[1]]);
-                }
-            }
-        }
-        // Constrained faces.
-        let mut dropped = vec![false; cav.shell.len()];
-        let mut seen: FxHashSet<u32> = FxHashSet::default();
-        let mut found_m = false;
-        let mkey = sorted3(m);
-        for &x in &cav.points {
-            let (a, b) = (self.surf_start[x as usize], self.surf_start[x as usize + 1]);
-            for &s in &self.surf_list[a as usize..b as usize] {
-                if !seen.insert(s) {
-                    continue;
-                }
-                let Some(v) = self.tri_map[s as usize] else {
-                    continue;
-                };
-                if v.iter().any(|&y| self.pt_mark[y as usize] != st) {
-                    continue;
-                }
-                let key = sorted3(v);
-                if shell_keys.contains(&key) {
-                    continue;
-                }
-                let place = if self.interior_face(v, st) {
-                    Place::Inside
-                } else {
-                    self.inside_cavity(v, cav, st)
-                };
-                let l = v.map(|y| self.pt_local[y as usize]);
-                match place {
-                    Place::Outside => {
-                        if key == mkey {
-                            return Err(Failure::NotInside);
-                        }
-                        continue;
-                    }
-                    Place::Inside => {
-                        cav.half.push(l);
-                        cav.half.push([l[0], l[2], l[1]]);
-                    }
-                    Place::OnBoundary { faces, inward } => {
-                        for k in faces {
-                            dropped[k] = true;
-                        }
-                        cav.half.push(if inward { l } else { [l[0], l[2], l[1]] });
-                    }
-                }
-                if key == mkey {
-                    found_m = true;
-                }
-            }
-        }
-        if dropped.iter().any(|&d| d) {
-            // Boundary faces re-triangulated by surface triangles in their plane.
-            let mut i = 0;
-            cav.half.retain(|_| {
-                i += 1;
-                dropped.get(i - 1).is_none_or(|&d| !d)
-            });
-        }
-        if !found_m {
-            return Err(Failure::NotInside);
-        }
-        if steiner {
-            self.add_steiner(cav)?;
-        }
-        Ok(())
-    }
-
-    /// Is `v` a face between two tets of the cavity?
-    fn interior_face(&self, v: [u32; 3], st: u32) -> bool {
-        self.with_star(v[0], |star| {
-            let mut n = 0;
-            for &t in star {
-                let tv = self.mesh.tets[t as usize];
-                if tv.contains(&v[1]) && tv.contains(&v[2]) {
-                    if self.tet_mark[t as usize] != st {
-                        return false;
-                    }
-                    n += 1;
-                }
-            }
-            n == 2
-        })
-    }
-
-    /// Does triangle `v` (corners in the cavity) lie inside the cavity? Exact: no improper
-    /// contact with any shell face, so its open part is entirely inside or entirely outside;
-    /// then the point `x = u + ε(w − u) + δ(v − u)` (0 < δ ≪ ε infinitesimal, inside the
-    /// triangle next to corner `u`) is located in the carved tets at `u`. The orientation of `x`
-    /// against a plane is the first non-zero of its orientations of `u`, `w`, `v`.
-    ///
-    /// A triangle in the plane of mesh boundary faces of the cavity (a surface triangle on the
-    /// convex hull, split differently) is [`Place::OnBoundary`]: those faces are replaced by it.
-    fn inside_cavity(&self, v: [u32; 3], cav: &Cavity, st: u32) -> Place {
-        let tp = v.map(|x| self.mesh.points[x as usize]);
-        let (lo, hi) = bbox(&tp);
-        let mut on_boundary = Vec::new();
-        for (i, (g, n, _)) in cav.shell.iter().enumerate() {
-            let gp = g.map(|x| self.mesh.points[x as usize]);
-            if (0..3).any(|k| gp.iter().all(|p| p[k] < lo[k]) || gp.iter().all(|p| p[k] > hi[k])) {
-                continue;
-            }
-            if tri_tri(&tp, &gp) == TriTri::Improper {
-                let coplanar = tp
-                    .iter()
-                    .all(|&p| orient3d(gp[0], gp[1], gp[2], p) == Sign::Zero);
-                if *n == NO_NEIGHBOR && coplanar {
-                    on_boundary.push(i);
-                    continue;
-                }
-                return Place::Outside;
-            }
-        }
-        if let Some(&i) = on_boundary.first() {
-            // Orient it like the boundary faces seen from inside: towards the cavity tet's apex.
-            let g = cav.shell[i].0;
-            let apex = cav.tets.iter().find_map(|&t| {
-                let tv = self.mesh.tets[t as usize];
-                let inside = g.iter().all(|x| tv.contains(x));
-                inside.then(|| tv.into_iter().find(|x| !g.contains(x)))?
-            });
-            let Some(apex) = apex else {
-                return Place::Outside;
-            };
-            let inward =
-                orient3d(tp[0], tp[1], tp[2], self.mesh.points[apex as usize]) == Sign::Positive;
-            return Place::OnBoundary {
-                faces: on_boundary,
-                inward,
-            };
-        }
-        let [u, vv, w] = tp;
-        // Any carved tet at u holding the symbolic point answers: no order, no allocation.
-        let inside = self.with_star(v[0], |star| {
-            star.iter().any(|&t| {
-                self.tet_mark[t as usize] == st && {
-                    let c = self.mesh.corners(t as usize);
-                    TET_FACES.iter().all(|f| {
-                        let (a, b, cc) = (c[f[0]], c[f[1]], c[f[2]]);
-                        let mut s = orient3d(a, b, cc, u);
-                        if s == Sign::Zero {
-                            s = orient3d(a, b, cc, w);
-                        }
-                        if s == Sign::Zero {
-                            s = orient3d(a, b, cc, vv);
-                        }
-                        s != Sign::Positive
-                    })
-                }
-            })
-        });
-        if inside {
-            Place::Inside
-        } else {
-            Place::Outside
-        }
-    }
-
-    /// Split into cells and search each; the new tets in global numbering.
-    fn fill_cells(&mut self, cav: &mut Cavity, nodes: &mut u64) -> Result<Vec<[u32; 4]>, Failure> {
-        let mut cell = Vec::new();
-        let n = self
-            .cells
-            .split(&cav.coords, &cav.half, &mut cell)
-            .map_err(|_| Failure::Cells)?;
-        let mut on_face = vec![false; cav.points.len()];
-        for f in &cav.half {
-            for &x in f {
-                on_face[x as usize] = true;
-            }
-        }
-        let inner: Vec<u32> = (0..cav.points.len() as u32)
-            .filter(|&x| !on_face[x as usize])
-            .collect();
-        let mut out = Vec::new();
-        let mut faces = Vec::new();
-        for c in 0..n as u32 {
-            faces.clear();
-            faces.extend(
-                cav.half
-                    .iter()
-                    .zip(&cell)
-                    .filter(|(_, k)| **k == c)
-                    .map(|(f, _)| *f),
-            );
-            // A first, cheaper try among better tets only (ηe raised): fewer candidates, and
-            // fewer slivers for the sliver removal that follows; the configured search if not.
-            let mut first = None;
-            if self.opts.first_quality > self.opts.search.min_quality {
-                let o = SearchOptions {
-                    min_quality: self.opts.first_quality,
-                    max_nodes: self.opts.search.max_nodes.min(FIRST_TRY_NODES),
-                    ..self.opts.search
-                };
-                match self.searcher.fill(&cav.coords, &faces, &inner, &o) {
-                    Ok(f) => first = Some(f),
-                    Err(e) => *nodes += nodes_of(&e),
-                }
-            }
-            let result = match first {
-                Some(f) => Ok(f),
-                None => self
-                    .searcher
-                    .fill(&cav.coords, &faces, &inner, &self.opts.search),
-            };
-            match result {
-                Ok(f) => {
-                    *nodes += f.nodes_visited;
-                    out.extend(f.tets.iter().map(|t| t.map(|x| cav.points[x as usize])));
-                }
-                Err(e) => {
-                    *nodes += nodes_of(&e);
-                    return Err(Failure::Search(e));
-                }
-            }
-        }
-        Ok(out)
     }
 
     /// Replace the cavity's tets by `new_tets`, keeping adjacency.
@@ -1116,6 +1507,7 @@ impl<'a> Recovery<'a> {
         }
         for &t in &cav.tets {
             self.alive[t as usize] = false;
+            self.claim[t as usize] = self.batch;
             self.free.push(t);
         }
         let mut slots = Vec::with_capacity(new_tets.len());
@@ -1135,15 +1527,17 @@ impl<'a> Recovery<'a> {
                     self.mesh.labels.reserve_exact(extra);
                     self.mesh.neighbors.reserve_exact(extra);
                     self.alive.reserve_exact(extra);
-                    self.tet_mark.reserve_exact(extra);
-                    self.star_mark.reserve_exact(extra);
+                    self.claim.reserve_exact(extra);
+                    self.work.tet_mark.reserve_exact(extra);
+                    self.work.star_mark.reserve_exact(extra);
                 }
                 self.mesh.tets.push(*t);
                 self.mesh.labels.push(label);
                 self.mesh.neighbors.push([NO_NEIGHBOR; 4]);
                 self.alive.push(true);
-                self.tet_mark.push(0);
-                self.star_mark.push(Cell::new(0));
+                self.claim.push(0);
+                self.work.tet_mark.push(0);
+                self.work.star_mark.push(Cell::new(0));
                 (self.mesh.tets.len() - 1) as u32
             };
             for &x in t {
@@ -1181,6 +1575,9 @@ impl<'a> Recovery<'a> {
                 }
             }
         }
+        for &s in &slots {
+            self.mark_present(s as usize);
+        }
     }
 
     /// Put one point strictly inside the cavity: the average of the cavity's points, when it
@@ -1207,8 +1604,11 @@ impl<'a> Recovery<'a> {
         self.mesh.points.push(p);
         self.vtet.push(NO_NEIGHBOR);
         self.surf_start.push(self.surf_list.len() as u32);
-        self.pt_mark.push(self.stamp);
-        self.pt_local.push(cav.points.len() as u32);
+        let w = &mut self.work;
+        w.pt_mark.push(w.stamp);
+        w.side_mark.push(0);
+        w.side.push(Sign::Zero);
+        w.pt_local.push(cav.points.len() as u32);
         cav.points.push(id);
         cav.coords.push(p);
         Ok(())
@@ -1232,7 +1632,7 @@ impl<'a> Recovery<'a> {
             let Some(v) = self.tri_map[s as usize] else {
                 continue;
             };
-            if self.present(v) {
+            if self.is_present[s as usize] {
                 continue;
             }
             let n0 = self.mesh.points.len();
@@ -1253,8 +1653,10 @@ impl<'a> Recovery<'a> {
             self.mesh.points.pop();
             self.vtet.pop();
             self.surf_start.pop();
-            self.pt_mark.pop();
-            self.pt_local.pop();
+            self.work.pt_mark.pop();
+            self.work.side_mark.pop();
+            self.work.side.pop();
+            self.work.pt_local.pop();
         }
     }
 
@@ -1307,19 +1709,17 @@ impl<'a> Recovery<'a> {
         before - k
     }
 
-    /// Flood-fill region labels from the surface's side labels and remove region 0. Returns
-    /// (tets removed, regions with conflicting votes).
+    /// Flood-fill region labels from the surface's side labels and remove region 0; sets
+    /// [`Self::is_present`] for the output. Returns (tets removed, regions with conflicting
+    /// votes).
     fn relabel(&mut self) -> (usize, usize) {
-        let mut wall: FxHashMap<[u32; 3], u32> = FxHashMap::default();
-        let mut on_surface = vec![false; self.mesh.points.len()];
-        for (s, m) in self.tri_map.iter().enumerate() {
-            if let Some(v) = m {
-                wall.insert(sorted3(*v), s as u32);
-                for &x in v {
-                    on_surface[x as usize] = true;
-                }
-            }
-        }
+        // The surface triangle at each tet face (`NO_NEIGHBOR`: none), looked up in parallel.
+        let view = self.view();
+        let walls: Vec<[u32; 4]> = (0..self.mesh.tets.len())
+            .into_par_iter()
+            .with_min_len(4096)
+            .map(|t| view.faces_on_surface(t).map(|s| s.unwrap_or(NO_NEIGHBOR)))
+            .collect();
         let n = self.mesh.tets.len();
         let mut comp = vec![u32::MAX; n];
         let mut conflicts = 0;
@@ -1336,12 +1736,11 @@ impl<'a> Recovery<'a> {
             let mut conflict = false;
             while let Some(t) = stack.pop() {
                 members.push(t);
-                for f in 0..4 {
-                    let g = self.mesh.face(t as usize, f);
-                    if g.iter().all(|&x| on_surface[x as usize])
-                        && let Some(&s) = wall.get(&sorted3(g))
+                for (f, &s) in walls[t as usize].iter().enumerate() {
+                    if s != NO_NEIGHBOR
                         && let Some(v) = self.tri_map[s as usize]
                     {
+                        let g = self.mesh.face(t as usize, f);
                         let behind = same_cyclic(g, v);
                         let sides = self.surface.sides[s as usize];
                         let l = if behind { sides[0] } else { sides[1] };
@@ -1364,6 +1763,15 @@ impl<'a> Recovery<'a> {
             } else if let Some(l) = vote {
                 for &t in &members {
                     self.mesh.labels[t as usize] = l;
+                }
+            }
+        }
+        // The triangles present in the output: faces of the tets kept.
+        self.is_present.fill(false);
+        for (t, w) in walls.iter().enumerate() {
+            if !self.opts.remove_outside || self.mesh.labels[t] != 0 {
+                for &s in w.iter().filter(|&&s| s != NO_NEIGHBOR) {
+                    self.mark_chain(s);
                 }
             }
         }

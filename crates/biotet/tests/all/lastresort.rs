@@ -668,3 +668,28 @@ fn improve_is_the_same_on_any_number_of_threads() {
     assert!(c.valid, "{c}");
     assert!((mesh_volume(&one) - mesh_volume(&base)).abs() < 1e-9 * mesh_volume(&base));
 }
+
+#[test]
+fn recover_is_the_same_on_any_number_of_threads() {
+    // Recovery fills the crossed tets of a batch of triangles in parallel and applies them in
+    // order: 1 and 2 threads must give the same tets and labels, complete and valid.
+    let s = crate::common::load_stl("brain_20k.stl");
+    let base = Delaunay::new(&s.points).unwrap().to_tet_mesh();
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let mut m = base.clone();
+        let r = pool.install(|| recover(&mut m, &s, &RecoverOptions::default()).unwrap());
+        (m, r)
+    };
+    let (one, r1) = run(1);
+    let (two, r2) = run(2);
+    assert_eq!(one.tets, two.tets);
+    assert_eq!(one.labels, two.labels);
+    assert_eq!((r1.calls, r1.nodes_total), (r2.calls, r2.nodes_total));
+    assert!(r1.missing_before > 0 && r1.is_complete(), "{r1:?}");
+    let c = check(&one, Some(&s));
+    assert!(c.valid, "{c}");
+}
