@@ -414,7 +414,7 @@ struct Recovery<'a> {
     /// Surface triangles in mesh point numbers (`None`: a corner is no mesh point).
     tri_map: Vec<Option<[u32; 3]>>,
     /// Mapped surface triangles by sorted corners (the last of equal ones) ...
-    face_tri: FxHashMap<[u32; 3], u32>,
+    face_tri: FaceIndex,
     /// ... and the previous triangle with the same corners (`NO_NEIGHBOR`: none).
     same_face: Vec<u32>,
     /// Which surface triangles are faces of live tets: set by [`Self::scan_present`], then kept
@@ -454,10 +454,12 @@ struct Recovery<'a> {
 /// before (fresh stamps).
 #[derive(Default)]
 struct Work {
-    tet_mark: Vec<u32>,
-    /// Stamps of the star walks, and the buffer of [`View::with_star`].
-    star_mark: Vec<Cell<u32>>,
-    star_stamp: Cell<u32>,
+    /// Per-tet marks hold the low 16 bits of a stamp (2 bytes a tet and thread, not 4): they
+    /// are cleared whenever those bits wrap, see [`Work::next_stamp`].
+    tet_mark: Vec<u16>,
+    /// Stamps of the star walks (cleared when they wrap), and the buffer of [`View::with_star`].
+    star_mark: Vec<Cell<u16>>,
+    star_stamp: Cell<u16>,
     star_buf: Cell<Vec<u32>>,
     /// Cached sides of points of the plane of the triangle whose crossed tets are walked.
     side_mark: Vec<u32>,
@@ -477,14 +479,65 @@ struct Work {
     cells: Cells,
 }
 
+/// Surface triangles by sorted corners, sorted: half the memory of a hash map, and looked up
+/// only at faces with three surface corners.
+struct FaceIndex(Vec<([u32; 3], u32)>);
+
+impl FaceIndex {
+    fn get(&self, key: [u32; 3]) -> Option<u32> {
+        self.0
+            .binary_search_by(|e| e.0.cmp(&key))
+            .ok()
+            .map(|i| self.0[i].1)
+    }
+}
+
+/// The per-tet mark of stamp `st`.
+fn low(st: u32) -> u16 {
+    st as u16
+}
+
 impl Work {
+    /// A fresh stamp. Its low 16 bits are never 0 (the cleared mark), and the per-tet marks are
+    /// cleared when they wrap, so a mark equals `low(st)` only if set with `st`.
+    fn next_stamp(&mut self) -> u32 {
+        self.stamp = self.stamp.wrapping_add(1);
+        if low(self.stamp) == 0 {
+            self.tet_mark.fill(0);
+            self.stamp = self.stamp.wrapping_add(1);
+        }
+        self.stamp
+    }
+
+    /// A fresh star-walk stamp (never 0, the marks cleared when it wraps).
+    fn next_star_stamp(&self) -> u16 {
+        let mut st = self.star_stamp.get().wrapping_add(1);
+        if st == 0 {
+            for m in &self.star_mark {
+                m.set(0);
+            }
+            st = 1;
+        }
+        self.star_stamp.set(st);
+        st
+    }
+
     /// Grow the per-tet and per-point marks to `tets` and `points` (new entries unmarked).
+    /// Exact growth: `resize` would double the capacity, and each thread's marks are as long
+    /// as the mesh.
     fn fit(&mut self, tets: usize, points: usize) {
         if self.tet_mark.len() < tets {
+            self.tet_mark.reserve_exact(tets - self.tet_mark.len());
+            self.star_mark.reserve_exact(tets - self.star_mark.len());
             self.tet_mark.resize(tets, 0);
             self.star_mark.resize(tets, Cell::new(0));
         }
         if self.pt_mark.len() < points {
+            let more = points - self.pt_mark.len();
+            self.pt_mark.reserve_exact(more);
+            self.pt_local.reserve_exact(more);
+            self.side_mark.reserve_exact(more);
+            self.side.reserve_exact(more);
             self.pt_mark.resize(points, 0);
             self.pt_local.resize(points, 0);
             self.side_mark.resize(points, 0);
@@ -502,7 +555,7 @@ struct View<'r> {
     surf_start: &'r [u32],
     surf_list: &'r [u32],
     opts: &'r RecoverOptions,
-    face_tri: &'r FxHashMap<[u32; 3], u32>,
+    face_tri: &'r FaceIndex,
 }
 
 /// A fill of a triangle's crossed tets found on a batch's view, applied later if nothing it
@@ -576,7 +629,7 @@ impl View<'_> {
         let mut out = [None; 4];
         for (f, g) in TET_FACES.iter().enumerate() {
             if on[g[0]] && on[g[1]] && on[g[2]] {
-                out[f] = self.face_tri.get(&sorted3(self.mesh.face(t, f))).copied();
+                out[f] = self.face_tri.get(sorted3(self.mesh.face(t, f)));
             }
         }
         out
@@ -589,8 +642,7 @@ impl View<'_> {
         if t0 == NO_NEIGHBOR {
             return;
         }
-        let st = w.star_stamp.get().wrapping_add(1);
-        w.star_stamp.set(st);
+        let st = w.next_star_stamp();
         w.star_mark[t0 as usize].set(st);
         out.push(t0);
         let mut i = 0;
@@ -643,8 +695,7 @@ impl View<'_> {
     fn crossed_tets(&self, w: &mut Work, v: [u32; 3]) -> Option<Vec<u32>> {
         let tp = v.map(|x| self.mesh.points[x as usize]);
         let (lo, hi) = bbox(&tp);
-        w.stamp += 1;
-        let st = w.stamp;
+        let st = w.next_stamp();
         let mut out = Vec::new();
         let mut stack = std::mem::take(&mut w.walk_buf);
         let mut star = w.star_buf.take();
@@ -652,8 +703,8 @@ impl View<'_> {
         for &c in &v {
             self.star_into(w, c, &mut star);
             for &t in &star {
-                if w.tet_mark[t as usize] != st {
-                    w.tet_mark[t as usize] = st;
+                if w.tet_mark[t as usize] != low(st) {
+                    w.tet_mark[t as usize] = low(st);
                     stack.push(t);
                 }
             }
@@ -692,8 +743,8 @@ impl View<'_> {
                 }
                 crossed = true;
                 let n = self.mesh.neighbors[t as usize][f];
-                if n != NO_NEIGHBOR && w.tet_mark[n as usize] != st {
-                    w.tet_mark[n as usize] = st;
+                if n != NO_NEIGHBOR && w.tet_mark[n as usize] != low(st) {
+                    w.tet_mark[n as usize] = low(st);
                     stack.push(n);
                 }
             }
@@ -725,16 +776,15 @@ impl View<'_> {
 
     /// Add the next ring: every tet across a face of the cavity.
     fn grow(&self, w: &mut Work, tets: &mut Vec<u32>) {
-        w.stamp += 1;
-        let st = w.stamp;
+        let st = w.next_stamp();
         for &t in tets.iter() {
-            w.tet_mark[t as usize] = st;
+            w.tet_mark[t as usize] = low(st);
         }
         let n = tets.len();
         for i in 0..n {
             for &nb in &self.mesh.neighbors[tets[i] as usize] {
-                if nb != NO_NEIGHBOR && w.tet_mark[nb as usize] != st {
-                    w.tet_mark[nb as usize] = st;
+                if nb != NO_NEIGHBOR && w.tet_mark[nb as usize] != low(st) {
+                    w.tet_mark[nb as usize] = low(st);
                     tets.push(nb);
                 }
             }
@@ -748,10 +798,9 @@ impl View<'_> {
         tets: &[u32],
         cav: &mut Cavity,
     ) -> Result<(), Failure> {
-        w.stamp += 1;
-        let st = w.stamp;
+        let st = w.next_stamp();
         for &t in tets {
-            w.tet_mark[t as usize] = st;
+            w.tet_mark[t as usize] = low(st);
         }
         cav.tets.extend_from_slice(tets);
         for &t in &cav.tets {
@@ -769,7 +818,7 @@ impl View<'_> {
         for &t in &cav.tets {
             for f in 0..4 {
                 let n = self.mesh.neighbors[t as usize][f];
-                if n == NO_NEIGHBOR || w.tet_mark[n as usize] != st {
+                if n == NO_NEIGHBOR || w.tet_mark[n as usize] != low(st) {
                     let g = self.mesh.face(t as usize, f);
                     let nf = if n == NO_NEIGHBOR {
                         0
@@ -883,7 +932,7 @@ impl View<'_> {
             for &t in star {
                 let tv = self.mesh.tets[t as usize];
                 if tv.contains(&v[1]) && tv.contains(&v[2]) {
-                    if w.tet_mark[t as usize] != st {
+                    if w.tet_mark[t as usize] != low(st) {
                         return false;
                     }
                     n += 1;
@@ -943,7 +992,7 @@ impl View<'_> {
         // Any carved tet at u holding the symbolic point answers: no order, no allocation.
         let inside = self.with_star(w, v[0], |star| {
             star.iter().any(|&t| {
-                w.tet_mark[t as usize] == st && {
+                w.tet_mark[t as usize] == low(st) && {
                     let c = self.mesh.corners(t as usize);
                     TET_FACES.iter().all(|f| {
                         let (a, b, cc) = (c[f[0]], c[f[1]], c[f[2]]);
@@ -1122,16 +1171,27 @@ impl<'a> Recovery<'a> {
             }
         }
         drop(fill);
-        let mut face_tri = FxHashMap::default();
-        face_tri.reserve(tri_map.len());
         let mut same_face = vec![NO_NEIGHBOR; tri_map.len()];
-        for (s, m) in tri_map.iter().enumerate() {
-            if let Some(v) = m
-                && let Some(prev) = face_tri.insert(sorted3(*v), s as u32)
-            {
-                same_face[s] = prev;
+        let mut faces: Vec<([u32; 3], u32)> = tri_map
+            .iter()
+            .enumerate()
+            .filter_map(|(s, m)| m.map(|v| (sorted3(v), s as u32)))
+            .collect();
+        faces.sort_unstable();
+        // Equal corners: each triangle remembers the one before it, the index keeps the last.
+        for k in 1..faces.len() {
+            if faces[k].0 == faces[k - 1].0 {
+                same_face[faces[k].1 as usize] = faces[k - 1].1;
             }
         }
+        faces.dedup_by(|later, earlier| {
+            let equal = later.0 == earlier.0;
+            if equal {
+                earlier.1 = later.1;
+            }
+            equal
+        });
+        let face_tri = FaceIndex(faces);
         let mut r = Recovery {
             mesh,
             surface,
@@ -1163,8 +1223,18 @@ impl<'a> Recovery<'a> {
         r
     }
 
+    /// Drop the per-tet and per-point scratch that [`Self::index`] rebuilds.
+    fn free_scratch(&mut self) {
+        self.alive = Vec::new();
+        self.claim = Vec::new();
+        self.vtet = Vec::new();
+        self.work.tet_mark = Vec::new();
+        self.work.star_mark = Vec::new();
+    }
+
     /// Rebuild the incidence lists from scratch.
     fn index(&mut self) {
+        self.free_scratch();
         let np = self.mesh.points.len();
         self.alive = vec![true; self.mesh.tets.len()];
         self.free.clear();
@@ -1196,6 +1266,8 @@ impl<'a> Recovery<'a> {
     /// `f` on the view with the serial scratch.
     fn with_work<R>(&mut self, f: impl FnOnce(View<'_>, &mut Work) -> R) -> R {
         let mut w = std::mem::take(&mut self.work);
+        // Marks for every tet slot the mesh can hold before it grows again.
+        w.fit(self.mesh.tets.capacity(), self.mesh.points.len());
         let r = f(self.view(), &mut w);
         self.work = w;
         r
@@ -1292,8 +1364,10 @@ impl<'a> Recovery<'a> {
     /// [`Self::attempt`] on the mesh as it is then. The result does not depend on the threads.
     fn run(&mut self) {
         let mut queue: VecDeque<u32> = self.missing_mapped().collect();
+        // The serial scratch joins the pool for each batch's parallel part: one scratch a
+        // thread, not one more (each holds 8 bytes a tet).
         let threads = rayon::current_num_threads().max(1);
-        let mut pool: Vec<Mutex<Work>> = (0..threads).map(|_| Mutex::default()).collect();
+        let mut pool: Vec<Mutex<Work>> = (1..threads).map(|_| Mutex::default()).collect();
         let mut stalled = 0usize;
         let mut batch: Vec<u32> = Vec::with_capacity(BATCH);
         let mut wait: Vec<u32> = Vec::new();
@@ -1330,7 +1404,9 @@ impl<'a> Recovery<'a> {
             if batch.is_empty() {
                 break;
             }
-            let (nt, np) = (self.mesh.tets.len(), self.mesh.points.len());
+            // To the mesh's capacity, which grows by an eighth: few reallocations.
+            let (nt, np) = (self.mesh.tets.capacity(), self.mesh.points.len());
+            pool.push(Mutex::new(std::mem::take(&mut self.work)));
             for w in &mut pool {
                 w.get_mut().unwrap_or_else(|e| e.into_inner()).fit(nt, np);
             }
@@ -1344,6 +1420,9 @@ impl<'a> Recovery<'a> {
                     view.try_crossed(&mut w, v)
                 })
                 .collect();
+            if let Some(w) = pool.pop() {
+                self.work = w.into_inner().unwrap_or_else(|e| e.into_inner());
+            }
             for (i, (&s, found)) in batch.iter().zip(found).enumerate() {
                 let Some(v) = self.tri_map[s as usize] else {
                     continue;
@@ -1421,13 +1500,12 @@ impl<'a> Recovery<'a> {
         }
         // The tets around the corners.
         let mut tets = self.with_work(|view, w| {
-            w.stamp += 1;
-            let st = w.stamp;
+            let st = w.next_stamp();
             let mut tets = Vec::new();
             for &c in &v {
                 for t in view.star(w, c) {
-                    if w.tet_mark[t as usize] != st {
-                        w.tet_mark[t as usize] = st;
+                    if w.tet_mark[t as usize] != low(st) {
+                        w.tet_mark[t as usize] = low(st);
                         tets.push(t);
                     }
                 }
@@ -1520,24 +1598,22 @@ impl<'a> Recovery<'a> {
                 s
             } else {
                 if self.mesh.tets.len() == self.mesh.tets.capacity() {
-                    // Grow by an eighth, not double: a fill adds few tets beyond the ones it
-                    // frees, and doubling the mesh arrays would set the peak memory.
-                    let extra = self.mesh.tets.len() / 8 + 64;
+                    // Grow by a 32nd, not double: a fill adds few tets beyond the ones it
+                    // frees (brain_20k: 2% in all), and the slack of every per-tet array
+                    // would set the peak memory. Large blocks are mapped on their own, so a
+                    // reallocation remaps instead of copying.
+                    let extra = self.mesh.tets.len() / 32 + 64;
                     self.mesh.tets.reserve_exact(extra);
                     self.mesh.labels.reserve_exact(extra);
                     self.mesh.neighbors.reserve_exact(extra);
                     self.alive.reserve_exact(extra);
                     self.claim.reserve_exact(extra);
-                    self.work.tet_mark.reserve_exact(extra);
-                    self.work.star_mark.reserve_exact(extra);
                 }
                 self.mesh.tets.push(*t);
                 self.mesh.labels.push(label);
                 self.mesh.neighbors.push([NO_NEIGHBOR; 4]);
                 self.alive.push(true);
                 self.claim.push(0);
-                self.work.tet_mark.push(0);
-                self.work.star_mark.push(Cell::new(0));
                 (self.mesh.tets.len() - 1) as u32
             };
             for &x in t {
@@ -1678,6 +1754,8 @@ impl<'a> Recovery<'a> {
                 k += 1;
             }
         }
+        // The per-tet scratch is rebuilt by `index`: freed first, so old and new never meet.
+        self.free_scratch();
         for t in 0..before {
             let new = index[t];
             if new == NO_NEIGHBOR {
@@ -1700,6 +1778,9 @@ impl<'a> Recovery<'a> {
         self.mesh.tets.truncate(k);
         self.mesh.labels.truncate(k);
         self.mesh.neighbors.truncate(k);
+        self.mesh.tets.shrink_to_fit();
+        self.mesh.labels.shrink_to_fit();
+        self.mesh.neighbors.shrink_to_fit();
         debug_assert_eq!(
             self.mesh.neighbors,
             crate::mesh::tet::face_adjacency(&self.mesh.tets).0,
@@ -1714,12 +1795,24 @@ impl<'a> Recovery<'a> {
     /// votes).
     fn relabel(&mut self) -> (usize, usize) {
         // The surface triangle at each tet face (`NO_NEIGHBOR`: none), looked up in parallel.
+        // One bit a face (a byte a tet, not 16): the few walls are looked up again when met.
         let view = self.view();
-        let walls: Vec<[u32; 4]> = (0..self.mesh.tets.len())
+        let walls: Vec<u8> = (0..self.mesh.tets.len())
             .into_par_iter()
             .with_min_len(4096)
-            .map(|t| view.faces_on_surface(t).map(|s| s.unwrap_or(NO_NEIGHBOR)))
+            .map(|t| {
+                let on = view.faces_on_surface(t);
+                (0..4).filter(|&f| on[f].is_some()).map(|f| 1u8 << f).sum()
+            })
             .collect();
+        let wall = |r: &Self, t: usize, f: usize| -> u32 {
+            if walls[t] & (1 << f) == 0 {
+                return NO_NEIGHBOR;
+            }
+            r.face_tri
+                .get(sorted3(r.mesh.face(t, f)))
+                .unwrap_or(NO_NEIGHBOR)
+        };
         let n = self.mesh.tets.len();
         let mut comp = vec![u32::MAX; n];
         let mut conflicts = 0;
@@ -1736,7 +1829,8 @@ impl<'a> Recovery<'a> {
             let mut conflict = false;
             while let Some(t) = stack.pop() {
                 members.push(t);
-                for (f, &s) in walls[t as usize].iter().enumerate() {
+                for f in 0..4 {
+                    let s = wall(self, t as usize, f);
                     if s != NO_NEIGHBOR
                         && let Some(v) = self.tri_map[s as usize]
                     {
@@ -1766,15 +1860,22 @@ impl<'a> Recovery<'a> {
                 }
             }
         }
+        drop(comp);
+        drop(stack);
+        drop(members);
         // The triangles present in the output: faces of the tets kept.
         self.is_present.fill(false);
-        for (t, w) in walls.iter().enumerate() {
-            if !self.opts.remove_outside || self.mesh.labels[t] != 0 {
-                for &s in w.iter().filter(|&&s| s != NO_NEIGHBOR) {
-                    self.mark_chain(s);
+        for (t, &bits) in walls.iter().enumerate() {
+            if bits != 0 && (!self.opts.remove_outside || self.mesh.labels[t] != 0) {
+                for f in 0..4 {
+                    let s = wall(self, t, f);
+                    if s != NO_NEIGHBOR {
+                        self.mark_chain(s);
+                    }
                 }
             }
         }
+        drop(walls);
         if !self.opts.remove_outside {
             return (0, conflicts);
         }
