@@ -197,7 +197,16 @@ struct Cand {
     state: u8,
     lo: P3,
     hi: P3,
+    /// The planes of its three new faces once validated (row `u32::MAX` before): a valid
+    /// candidate is filtered against every tet added, and the row look-ups were a fifth of that.
+    planes: [Plane; 3],
 }
+
+/// The plane of [`Cand::planes`] not yet looked up.
+const NO_PLANE: Plane = Plane {
+    row: u32::MAX,
+    even: true,
+};
 
 /// Undo record of one search level.
 #[derive(Debug, Clone, Copy)]
@@ -298,18 +307,26 @@ impl Plane {
     }
 }
 
-/// Sorted corners and whether `f` is an even permutation of them.
-#[inline]
+/// Empty `m` for a search expected to need about `want` entries: clearing a hash map costs its
+/// capacity, and one large search would otherwise make every later small one pay for it.
+fn reset_map<K, V>(m: &mut FxHashMap<K, V>, want: usize) {
+    if m.capacity() > 4 * want {
+        *m = FxHashMap::default();
+    } else {
+        m.clear();
+    }
+}
+
 /// Area over the sum of squared edges (up to a constant): small for a thin triangle.
 fn tri_shape(c: &[P3; 3]) -> f64 {
     let (u, v, w) = (sub(c[1], c[0]), sub(c[2], c[0]), sub(c[2], c[1]));
     norm(cross(u, v)) / (norm2(u) + norm2(v) + norm2(w))
 }
 
-/// q³ (eq. 4.9 cubed): the same order as q without its cube root, for ranking candidates.
+/// q³ (eq. 4.9 cubed) of the tet `c` of volume `v`: the same order as q without its cube root,
+/// for ranking candidates.
 #[inline]
-fn q_cubed(c: &[P3; 4]) -> f64 {
-    let v = volume(c);
+fn q_cubed(v: f64, c: &[P3; 4]) -> f64 {
     let l2: f64 = crate::mesh::tet::TET_EDGES
         .iter()
         .map(|&[i, j]| norm2(sub(c[i], c[j])))
@@ -346,6 +363,8 @@ fn dihedrals_above(c: &[P3; 4], floor: f64) -> bool {
     })
 }
 
+/// Sorted corners and whether `f` is an even permutation of them.
+#[inline]
 fn sort3(f: [u32; 3]) -> ([u32; 3], bool) {
     let [mut a, mut b, mut c] = f;
     let mut even = true;
@@ -553,12 +572,13 @@ impl Searcher {
         self.front_deg.resize(np, 0);
         self.uses.clear();
         self.uses.resize(np, 0);
-        self.rows.clear();
+        let want = 8 * shell.len() + 64;
+        reset_map(&mut self.rows, want);
         self.orient.clear();
         self.row_keys.clear();
         self.faces.clear();
         self.cands.clear();
-        self.map.clear();
+        reset_map(&mut self.map, want);
         self.kill_log.clear();
         self.removed_log.clear();
         self.front.clear();
@@ -848,20 +868,22 @@ impl Searcher {
         orient3d(p[a as usize], p[b as usize], p[c as usize], p[d as usize])
     }
 
-    /// The outward faces of the candidate tet `face + p` and their planes.
+    /// The outward faces of candidate `k` of face `f` and their planes (looked up once per
+    /// candidate).
     #[inline]
-    fn cand_planes(&mut self, f: u32, p: u32) -> ([[u32; 3]; 4], [Plane; 4]) {
-        let v = self.faces[f as usize].v;
-        let tf = tet_faces([v[0], v[1], v[2], p]);
-        (
-            tf,
-            [
-                self.plane(tf[0]),
-                self.plane(tf[1]),
-                self.plane(tf[2]),
-                self.faces[f as usize].plane.flip(),
-            ],
-        )
+    fn cand_planes(&mut self, f: u32, k: u32) -> ([[u32; 3]; 4], [Plane; 4]) {
+        let face = &self.faces[f as usize];
+        let (v, base) = (face.v, face.plane.flip());
+        let c = self.cands[k as usize];
+        let tf = tet_faces([v[0], v[1], v[2], c.p]);
+        let pl = if c.planes[0].row == u32::MAX {
+            let pl = [self.plane(tf[0]), self.plane(tf[1]), self.plane(tf[2])];
+            self.cands[k as usize].planes = pl;
+            pl
+        } else {
+            c.planes
+        };
+        (tf, [pl[0], pl[1], pl[2], base])
     }
 
     /// Compute the candidates of face `f` (its range is the end of `cands`).
@@ -871,11 +893,32 @@ impl Searcher {
         let start = self.cands.len();
         self.find_wedges(f as u32);
         let wedge = self.wedge;
+        // The tests are a conjunction, so their order is free: with a float threshold the float
+        // tests run first (they reject most apexes, the point behind the face included, and
+        // cost less than a first exact orientation); without one, the exact test first.
+        let floats_first = self.eta > 0.0 || self.floor.is_some() || self.bound > f64::NEG_INFINITY;
         'apex: for p in 0..self.pts.len() as u32 {
             if v.contains(&p) || !self.usable(p) {
                 continue;
             }
-            if self.side(f as u32, p) != Sign::Positive {
+            if !floats_first && self.side(f as u32, p) != Sign::Positive {
+                continue;
+            }
+            let d = self.pts[p as usize];
+            let corners = [a, b, c, d];
+            let vol = volume(&corners);
+            // q³ ≤ 0 is at most ηe³ when ηe > 0: `above_eta` would refuse it.
+            if self.eta > 0.0 && vol <= 0.0 {
+                continue;
+            }
+            let q = q_cubed(vol, &corners);
+            if (self.eta > 0.0 && !self.above_eta(q, &corners))
+                || q <= self.bound
+                || self.floor.is_some_and(|f| !dihedrals_above(&corners, f))
+            {
+                continue;
+            }
+            if floats_first && self.side(f as u32, p) != Sign::Positive {
                 continue;
             }
             // Convex wedge at an edge: the apex must be in front of the face across it (or be
@@ -886,15 +929,6 @@ impl Searcher {
                     continue 'apex;
                 }
             }
-            let d = self.pts[p as usize];
-            let corners = [a, b, c, d];
-            let q = q_cubed(&corners);
-            if (self.eta > 0.0 && !self.above_eta(q, &corners))
-                || q <= self.bound
-                || self.floor.is_some_and(|f| !dihedrals_above(&corners, f))
-            {
-                continue;
-            }
             let (lo, hi) = bbox(&corners);
             self.cands.push(Cand {
                 p,
@@ -902,6 +936,7 @@ impl Searcher {
                 state: UNCHECKED,
                 lo,
                 hi,
+                planes: [NO_PLANE; 3],
             });
         }
         self.cands[start..].sort_by(|x, y| y.q.total_cmp(&x.q).then(x.p.cmp(&y.p)));
@@ -931,7 +966,7 @@ impl Searcher {
         let c = self.cands[k as usize];
         let v = self.faces[f as usize].v;
         let t = [v[0], v[1], v[2], c.p];
-        let (tf, planes) = self.cand_planes(f, c.p);
+        let (tf, planes) = self.cand_planes(f, k);
         let ok = !(self.contains_point(t, &planes, c.lo, c.hi)
             || self.hits_front(t, &tf, &planes, f, c.lo, c.hi));
         self.set_state(f, k, if ok { VALID } else { DEAD });
@@ -1001,6 +1036,10 @@ impl Searcher {
                 continue;
             }
             let hv = self.faces[h as usize].v;
+            // A face across an edge shares two corners; most share none.
+            if hv.iter().filter(|x| v.contains(x)).count() < 2 {
+                continue;
+            }
             for k in 0..3 {
                 let (a, b) = (v[k], v[(k + 1) % 3]);
                 // The face across runs the edge backwards.
@@ -1197,7 +1236,7 @@ impl Searcher {
                     continue;
                 }
                 let ct = [fr.v[0], fr.v[1], fr.v[2], c.p];
-                let (cf, cp) = self.cand_planes(f as u32, c.p);
+                let (cf, cp) = self.cand_planes(f as u32, k);
                 if self.tets_conflict(ct, &cf, &cp, t, &tf, &tp) {
                     self.set_state(f as u32, k, DEAD);
                 }
