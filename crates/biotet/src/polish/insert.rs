@@ -1,8 +1,8 @@
 //! Steiner points: fix an unforced tet below the threshold with one new interior point.
 //!
 //! The cavity is the tet and its unforced face neighbours of the same label, or, when that fails,
-//! every unforced tet of its label sharing an edge with it (a cavity with an interior point is not
-//! tried). Boundary and interface faces are never crossed, so they stay on the cavity's shell.
+//! every unforced tet of its label sharing an edge with it, or else the face cavity with its
+//! unforced face neighbours of the label (a cavity with an interior point is not tried). Boundary and interface faces are never crossed, so they stay on the cavity's shell.
 //! The candidates are the tet's centroid and circumcentre, the centroids of the cavity's tets, the
 //! midpoints between the tet's centroid and theirs, the shell's vertex centroid, and points pushed
 //! into the shell's kernel from the two centroids (cyclic projection, floating point).
@@ -76,10 +76,27 @@ impl Work {
         }
         edges.sort_unstable();
         edges.dedup();
-        if edges == faces {
+        if edges != faces
+            && let Some(ids) = self.insert_into(t, edges.clone(), thr, searcher, rp, sp, star)
+        {
+            return Some(ids);
+        }
+        // The face cavity and its face neighbours (past the edge cavity where a wedge's far
+        // edge or a sliver's neighbours need a point further out).
+        let mut ring = faces.clone();
+        for &s in &faces {
+            for n in self.nb[s as usize] {
+                if n != NO_NEIGHBOR && self.labels[n as usize] == label && !self.is_forced(n) {
+                    ring.push(n);
+                }
+            }
+        }
+        ring.sort_unstable();
+        ring.dedup();
+        if ring == faces || ring == edges {
             return None;
         }
-        self.insert_into(t, edges, thr, searcher, rp, sp, star)
+        self.insert_into(t, ring, thr, searcher, rp, sp, star)
     }
 
     /// A wedge: `t`'s one small angle, at edge `cd`, comes from the short opposite edge `ab`
