@@ -104,7 +104,7 @@ impl Work {
     /// `cd` sees both `a` and `b` keeps it. One point in front of `ab`, four times its length
     /// towards `cd`, with the stars of `a` and `b` refilled around it, can give `ab` a ring of
     /// near points. The search fills the stars with it as the one inner point (every tet above
-    /// the threshold, then above the cavity's worst); kept only if the cavity's worst unforced
+    /// the threshold, then, with `lower`, above the cavity's worst); kept only if the cavity's worst unforced
     /// angle rises, its worst does not fall and fewer of its tets are below the threshold.
     pub fn insert_wedge(
         &mut self,
@@ -113,6 +113,7 @@ impl Work {
         searcher: &mut Searcher,
         rp: &RefillParams,
         star: &mut Vec<u32>,
+        lower: bool,
     ) -> Option<Vec<u32>> {
         let c = self.corners(t);
         let ang = dihedral_angles(&c);
@@ -170,6 +171,9 @@ impl Work {
         self.pts.push(x);
         let mut out = None;
         for floor in [thr, old.1.max(0.0) * (1.0 + 1e-9)] {
+            if floor < thr && !lower {
+                break;
+            }
             // A fill has a tet below the threshold on at least a quarter of the faces without a
             // point above it: no fewer than before, no fill can pass.
             if floor < thr

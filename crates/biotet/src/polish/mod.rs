@@ -67,6 +67,10 @@ pub struct PolishOptions {
     /// Where the one-point insertion fails on a wedge (one small angle opposite a short edge),
     /// try a point in front of the short edge with the stars of its ends refilled.
     pub wedge: bool,
+    /// Let the wedge step also search fills above the cavity's worst tet, not only above the
+    /// threshold: on brain_20k 7 wedges fixed instead of 3, at 0.07 s (0.5 s on the nested
+    /// model).
+    pub wedge_lower_floor: bool,
 }
 
 impl Default for PolishOptions {
@@ -81,6 +85,7 @@ impl Default for PolishOptions {
             insert: true,
             insert_rounds: 3,
             wedge: true,
+            wedge_lower_floor: true,
         }
     }
 }
@@ -232,7 +237,7 @@ pub fn polish(mesh: &mut TetMesh, opts: &PolishOptions) -> PolishReport {
                 &mut star,
                 &mut report,
                 &mut tried,
-                opts.wedge,
+                opts.wedge.then_some(opts.wedge_lower_floor),
             ) {
                 break;
             }
@@ -368,7 +373,7 @@ fn insert_round(
     star: &mut Vec<u32>,
     report: &mut PolishReport,
     tried: &mut FxHashSet<u64>,
-    wedge: bool,
+    wedge: Option<bool>,
 ) -> bool {
     let mut any = false;
     for &(_, t) in bad.iter() {
@@ -385,7 +390,9 @@ fn insert_round(
             any = true;
             continue;
         }
-        if wedge && w.insert_wedge(t, thr, searcher, rp, star).is_some() {
+        if let Some(lower) = wedge
+            && w.insert_wedge(t, thr, searcher, rp, star, lower).is_some()
+        {
             report.inserts_accepted += 1;
             report.wedges_accepted += 1;
             any = true;
