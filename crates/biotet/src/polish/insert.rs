@@ -1,8 +1,8 @@
 //! Steiner points: fix an unforced tet below the threshold with one new interior point.
 //!
 //! The cavity is the tet and its unforced face neighbours of the same label, or, when that fails,
-//! every unforced tet of its label sharing an edge with it (a cavity with an interior point is not
-//! tried). Boundary and interface faces are never crossed, so they stay on the cavity's shell.
+//! every unforced tet of its label sharing an edge with it, or else the face cavity with its
+//! unforced face neighbours of the label (a cavity with an interior point is not tried). Boundary and interface faces are never crossed, so they stay on the cavity's shell.
 //! The candidates are the tet's centroid and circumcentre, the centroids of the cavity's tets, the
 //! midpoints between the tet's centroid and theirs, the shell's vertex centroid, and points pushed
 //! into the shell's kernel from the two centroids (cyclic projection, floating point).
@@ -18,14 +18,18 @@
 //! cavities only) every tet above the cavity's worst before. The result is kept only if the
 //! cavity's worst unforced angle rises, its worst angle does not fall and no more of its tets are
 //! below the threshold; otherwise the old tets come back under their ids and the point is dropped.
+//!
+//! A wedge (one small angle, at the edge opposite a short one, mostly a short surface edge) that
+//! this leaves gets one more try ([`Work::insert_wedge`]): one point in front of the short edge
+//! and the stars of its two ends refilled around it.
 
 use rustc_hash::FxHashSet;
 
 use crate::geom::predicates::{Sign, in_exact_range, orient3d};
 use crate::geom::vec3::{add, cross, dot, norm2, scale, sub, volume6};
 use crate::lastresort::Searcher;
-use crate::mesh::tet::NO_NEIGHBOR;
-use crate::quality::tet::min_dihedral_chord2;
+use crate::mesh::tet::{NO_NEIGHBOR, TET_EDGES};
+use crate::quality::tet::{dihedral_angles, min_dihedral_chord2};
 
 use super::refill::{RefillParams, every_face_has_candidate, faces_without_candidate, judge};
 use super::relocate::StepParams;
@@ -72,10 +76,151 @@ impl Work {
         }
         edges.sort_unstable();
         edges.dedup();
-        if edges == faces {
+        if edges != faces
+            && let Some(ids) = self.insert_into(t, edges.clone(), thr, searcher, rp, sp, star)
+        {
+            return Some(ids);
+        }
+        // The face cavity and its face neighbours (past the edge cavity where a wedge's far
+        // edge or a sliver's neighbours need a point further out).
+        let mut ring = faces.clone();
+        for &s in &faces {
+            for n in self.nb[s as usize] {
+                if n != NO_NEIGHBOR && self.labels[n as usize] == label && !self.is_forced(n) {
+                    ring.push(n);
+                }
+            }
+        }
+        ring.sort_unstable();
+        ring.dedup();
+        if ring == faces || ring == edges {
             return None;
         }
-        self.insert_into(t, edges, thr, searcher, rp, sp, star)
+        self.insert_into(t, ring, thr, searcher, rp, sp, star)
+    }
+
+    /// A wedge: `t`'s one small angle, at edge `cd`, comes from the short opposite edge `ab`
+    /// (two points close together, mostly a short surface edge), so any fill where the far edge
+    /// `cd` sees both `a` and `b` keeps it. One point in front of `ab`, four times its length
+    /// towards `cd`, with the stars of `a` and `b` refilled around it, can give `ab` a ring of
+    /// near points. The search fills the stars with it as the one inner point (every tet above
+    /// the threshold, then, with `lower`, above the cavity's worst); kept only if the cavity's worst unforced
+    /// angle rises, its worst does not fall and fewer of its tets are below the threshold.
+    pub fn insert_wedge(
+        &mut self,
+        t: u32,
+        thr: f64,
+        searcher: &mut Searcher,
+        rp: &RefillParams,
+        star: &mut Vec<u32>,
+        lower: bool,
+    ) -> Option<Vec<u32>> {
+        let c = self.corners(t);
+        let ang = dihedral_angles(&c);
+        let e = (0..6).min_by(|&i, &j| ang[i].total_cmp(&ang[j]))?;
+        let [ic, id] = TET_EDGES[e];
+        let [ia, ib] = TET_EDGES[5 - e];
+        // One small angle, none near flat (not a sliver or a cap), the opposite edge short.
+        let lo = thr.to_radians();
+        let lab2 = norm2(sub(c[ia], c[ib]));
+        if ang.iter().filter(|&&x| x < lo).count() != 1
+            || ang.iter().any(|&x| x > std::f64::consts::PI - 3.0 * lo)
+            || lab2 > 0.25 * norm2(sub(c[ic], c[id]))
+        {
+            return None;
+        }
+        let tv = self.tets[t as usize];
+        let label = self.labels[t as usize];
+        let mut tets = Vec::new();
+        for v in [tv[ia], tv[ib]] {
+            self.star(v, star);
+            for &s in star.iter() {
+                if self.labels[s as usize] == label && !self.is_forced(s) {
+                    tets.push(s);
+                }
+            }
+        }
+        tets.sort_unstable();
+        tets.dedup();
+        if tets.len() > rp.max_tets {
+            return None;
+        }
+        let cav = self.cavity(tets);
+        let on_shell: FxHashSet<u32> = cav.shell.iter().flatten().copied().collect();
+        if cav
+            .tets
+            .iter()
+            .any(|&s| self.tets[s as usize].iter().any(|v| !on_shell.contains(v)))
+        {
+            return None;
+        }
+        let m = scale(add(c[ia], c[ib]), 0.5);
+        let dir = sub(scale(add(c[ic], c[id]), 0.5), m);
+        let ld = norm2(dir).sqrt();
+        if ld == 0.0 || lab2 == 0.0 {
+            return None;
+        }
+        let x = add(m, scale(dir, (4.0 * lab2.sqrt()).min(0.5 * ld) / ld));
+        if !x.iter().all(|&v| in_exact_range(v)) || !self.strictly_inside(&cav.tets, x) {
+            return None;
+        }
+        let old = judge(self, &cav.tets, thr);
+        let p = self.pts.len() as u32;
+        let mut cands: Vec<u32> = on_shell.iter().copied().chain([p]).collect();
+        cands.sort_unstable();
+        self.pts.push(x);
+        let mut out = None;
+        for floor in [thr, old.1.max(0.0) * (1.0 + 1e-9)] {
+            if floor < thr && !lower {
+                break;
+            }
+            // A fill has a tet below the threshold on at least a quarter of the faces without a
+            // point above it: no fewer than before, no fill can pass.
+            if floor < thr
+                && faces_without_candidate(&self.pts, &cav.shell, &cands, thr).div_ceil(4) + 1
+                    > old.2
+            {
+                break;
+            }
+            if !every_face_has_candidate(&self.pts, &cav.shell, &cands, floor) {
+                continue;
+            }
+            let Ok(f) = searcher.fill_carved(&self.pts, &cav.shell, &[p], &rp.options(floor))
+            else {
+                continue;
+            };
+            self.vtet.push(NO_NEIGHBOR);
+            self.fixed.push(false);
+            let old_tets: Vec<[u32; 4]> = cav.tets.iter().map(|&s| self.tets[s as usize]).collect();
+            let ids = self.replace(&cav, &f.tets);
+            let new = judge(self, &ids, thr);
+            if new.0 > old.0 && new.1 >= old.1 && new.2 < old.2 {
+                out = Some(ids);
+            } else {
+                let back = self.cavity(ids);
+                self.replace_in(&back, &old_tets, Some(&cav.tets));
+                debug_assert_eq!(self.vtet[p as usize], NO_NEIGHBOR);
+                self.vtet.pop();
+                self.fixed.pop();
+            }
+            break;
+        }
+        if out.is_none() {
+            self.pts.pop();
+        }
+        out
+    }
+
+    /// Whether `x` is strictly inside one of `tets` (exact).
+    fn strictly_inside(&self, tets: &[u32], x: P3) -> bool {
+        tets.iter().any(|&s| {
+            let c = self.corners(s);
+            (0..4).all(|k| {
+                let mut d = c;
+                d[k] = x;
+                orient3d(d[0], d[1], d[2], d[3]) == Sign::Positive
+            })
+        })
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -144,7 +289,7 @@ impl Work {
                     continue;
                 }
                 let so = rp.options(floor);
-                let r = searcher.fill(&self.pts, &cav.shell, &[p], &so);
+                let r = searcher.fill_carved(&self.pts, &cav.shell, &[p], &so);
                 if let Ok(f) = r {
                     let cur = self.cavity(ids);
                     ids = self.replace(&cur, &f.tets);
