@@ -130,10 +130,6 @@ pub struct MoveCounts {
     pub budget: usize,
     /// Fills found but not better by the metric.
     pub not_better: usize,
-    /// Searches not run because the same cavity (the same tets, in the same order, so the same
-    /// shell and bound) already failed: counted here only, not in `calls` or `ms` (see
-    /// [`Work::failed`]).
-    pub cached: usize,
 }
 
 /// What [`improve`] did.
@@ -244,19 +240,6 @@ struct Work<'a> {
     free: Vec<u32>,
     /// Per tet: its local moves were tried and failed (it waits for its larger cavities).
     local_tried: Vec<bool>,
-    /// The local-move cavities whose search failed, by their tets' corners in cavity order.
-    /// The search reads nothing else (the shell, the inner points and the bound all follow
-    /// from them, and points never move), so the same key fails again: such cavities are not
-    /// searched, only claimed as before (the batches stay the same). A tet's corners never
-    /// change, so no entry goes stale.
-    failed: FxHashSet<Box<[[u32; 4]]>>,
-    /// The same for searches that failed at the root (a shell face without any candidate), by
-    /// their tets' corners sorted: in another order the shell is the same triangles in another
-    /// order, and each face's candidates do not depend on that order, so the root fails again
-    /// (the same ring reached from another of its tets).
-    failed_root: FxHashSet<Box<[[u32; 4]]>>,
-    /// Scratch key for [`Work::failed`].
-    key: Vec<[u32; 4]>,
     opts: ImproveOptions,
     report: ImproveReport,
     /// Per search: milliseconds and nodes (for the medians; a byte count per search matters on
@@ -287,8 +270,6 @@ struct Outcome {
     ms: f64,
     /// The fill's worst tet in the metric (`-inf` without a fill).
     new_worst: f64,
-    /// A shell face had no candidate at all ([`Searcher::failed_at_root`]).
-    root_empty: bool,
 }
 
 impl Outcome {
@@ -325,7 +306,6 @@ fn search_cavity(
         result,
         ms,
         new_worst,
-        root_empty: searcher.failed_at_root(),
     }
 }
 
@@ -545,40 +525,6 @@ impl<'a> Work<'a> {
                 }
                 false
             }
-        }
-    }
-
-    /// The report's counts of a kind of move.
-    fn counts(kind: Kind) -> fn(&mut ImproveReport) -> &mut MoveCounts {
-        match kind {
-            Kind::Flip => |r| &mut r.face_flips,
-            Kind::Ring => |r| &mut r.edge_removals,
-            Kind::Edges => |r| &mut r.edge_cavities,
-            Kind::Star => |r| &mut r.star_cavities,
-            Kind::Grown => |r| &mut r.grown_cavities,
-        }
-    }
-
-    /// Would the search of the cavity of `tets` (in this order) fail, as one did before?
-    fn known_failed(&mut self, tets: &[u32]) -> bool {
-        self.key.clear();
-        self.key.extend(tets.iter().map(|&t| self.tets[t as usize]));
-        if self.failed.contains(self.key.as_slice()) {
-            return true;
-        }
-        self.key.sort_unstable();
-        self.failed_root.contains(self.key.as_slice())
-    }
-
-    /// Remember that the search of the cavity of `tets` (in this order) failed (see
-    /// [`Work::failed`]).
-    fn remember_failed(&mut self, tets: &[u32], out: &Outcome) {
-        let mut key: Box<[[u32; 4]]> = tets.iter().map(|&t| self.tets[t as usize]).collect();
-        if out.root_empty {
-            key.sort_unstable();
-            self.failed_root.insert(key);
-        } else {
-            self.failed.insert(key);
         }
     }
 
@@ -841,15 +787,7 @@ fn step(w: &mut Work, tet: u32, scratch: &mut Vec<u32>) -> Step {
             if w.claimed(&all) {
                 return Step::Conflict;
             }
-            // Claimed as if searched, so that the batches do not change.
             w.claim(&all);
-            tries.retain(|(kind, c)| {
-                let hit = w.known_failed(c);
-                if hit {
-                    Work::counts(*kind)(&mut w.report).cached += 1;
-                }
-                !hit
-            });
             return Step::Task(Box::new(Task {
                 tet,
                 local: true,
@@ -960,17 +898,19 @@ fn run_batch(w: &mut Work, batch: &mut Vec<Task>) {
             let (Some(out), Some(plan)) = (&t.out, &t.plan) else {
                 continue;
             };
-            let counts = Work::counts(t.kind);
+            let counts: fn(&mut ImproveReport) -> &mut MoveCounts = match t.kind {
+                Kind::Flip => |r| &mut r.face_flips,
+                Kind::Ring => |r| &mut r.edge_removals,
+                Kind::Edges => |r| &mut r.edge_cavities,
+                Kind::Star => |r| &mut r.star_cavities,
+                Kind::Grown => |r| &mut r.grown_cavities,
+            };
             if w.record(out, plan, counts) {
                 if let Ok(fill) = &out.result {
                     w.replace(&t.cav, &fill.tets);
                 }
                 fixed = true;
                 break;
-            }
-            // Not accepted; the cavity's tets are as searched (tasks of a batch are apart).
-            if task.local {
-                w.remember_failed(&t.cav.tets, out);
             }
         }
         if task.local && !fixed {
@@ -1046,9 +986,6 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
         star_stamp: 0,
         free: Vec::new(),
         local_tried: Vec::new(),
-        failed: FxHashSet::default(),
-        failed_root: FxHashSet::default(),
-        key: Vec::new(),
         opts: *opts,
         report: ImproveReport {
             metric: Some(opts.metric),
@@ -1137,8 +1074,6 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     }
     w.cache = Vec::new();
     w.local_tried = Vec::new();
-    w.failed = FxHashSet::default();
-    w.failed_root = FxHashSet::default();
     let mut index = vec![NO_NEIGHBOR; w.tets.len()];
     let mut k = 0u32;
     for (t, slot) in index.iter_mut().enumerate() {

@@ -276,9 +276,6 @@ pub struct Searcher {
     /// Per edge of the face whose candidates are computed: the apex of the one other front face
     /// across it, and that face, when the region's wedge there is convex.
     wedge: [Option<u32>; 3],
-    /// The last call failed at the root: a shell face without any candidate (see
-    /// [`Self::failed_at_root`]).
-    root_empty: bool,
 }
 
 /// Marks a not yet computed entry of `Searcher::orient`.
@@ -447,7 +444,6 @@ impl Searcher {
         inner: &[u32],
         opts: &SearchOptions,
     ) -> Result<Fill, SearchError> {
-        self.root_empty = false;
         self.load(points, shell, inner, false)?;
         self.run(opts)
     }
@@ -462,16 +458,8 @@ impl Searcher {
         inner: &[u32],
         opts: &SearchOptions,
     ) -> Result<Fill, SearchError> {
-        self.root_empty = false;
         self.load(points, shell, inner, !cfg!(debug_assertions))?;
         self.run(opts)
-    }
-
-    /// Did the last call fail because a shell face had no candidate at all? That does not depend
-    /// on the order of the shell's faces (each face's candidates are made from the same faces
-    /// and points whatever the order), unlike a failure further down.
-    pub(crate) fn failed_at_root(&self) -> bool {
-        self.root_empty
     }
 
     /// The search proper, on a loaded shell.
@@ -509,7 +497,6 @@ impl Searcher {
             self.faces[f as usize].live == 0
         });
         self.root_order = root;
-        self.root_empty = empty;
         if empty {
             return Err(SearchError::NoFill { nodes_visited: 1 });
         }
