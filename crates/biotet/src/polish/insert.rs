@@ -33,7 +33,7 @@ use crate::quality::tet::{dihedral_angles, min_dihedral_chord2};
 
 use super::refill::{RefillParams, every_face_has_candidate, faces_without_candidate, judge};
 use super::relocate::StepParams;
-use super::work::{P3, Work};
+use super::work::{Cavity, P3, Work};
 
 impl Work {
     /// Try to raise `t` (unforced, below `thr` degrees) with one new interior point; the new
@@ -145,15 +145,7 @@ impl Work {
         if tets.len() > rp.max_tets {
             return None;
         }
-        let cav = self.cavity(tets);
-        let on_shell: FxHashSet<u32> = cav.shell.iter().flatten().copied().collect();
-        if cav
-            .tets
-            .iter()
-            .any(|&s| self.tets[s as usize].iter().any(|v| !on_shell.contains(v)))
-        {
-            return None;
-        }
+        let (cav, on_shell) = self.cavity_of_shell_points(tets)?;
         let m = scale(add(c[ia], c[ib]), 0.5);
         let dir = sub(scale(add(c[ic], c[id]), 0.5), m);
         let ld = norm2(dir).sqrt();
@@ -212,6 +204,19 @@ impl Work {
     }
 
     /// Whether `x` is strictly inside one of `tets` (exact).
+    /// The cavity of `tets`, if every corner of its tets is on its shell (an inner point would
+    /// be lost: the refill takes the new point as its only inner point).
+    /// Also returns the shell's points.
+    fn cavity_of_shell_points(&self, tets: Vec<u32>) -> Option<(Cavity, FxHashSet<u32>)> {
+        let cav = self.cavity(tets);
+        let on_shell: FxHashSet<u32> = cav.shell.iter().flatten().copied().collect();
+        let lost = cav
+            .tets
+            .iter()
+            .any(|&s| self.tets[s as usize].iter().any(|v| !on_shell.contains(v)));
+        (!lost).then_some((cav, on_shell))
+    }
+
     fn strictly_inside(&self, tets: &[u32], x: P3) -> bool {
         tets.iter().any(|&s| {
             let c = self.corners(s);
@@ -241,15 +246,7 @@ impl Work {
         // threshold are searched: the lower floor's fills there cost twice as much per
         // insertion kept.
         let large = tets.len() > 5;
-        let cav = self.cavity(tets);
-        let on_shell: FxHashSet<u32> = cav.shell.iter().flatten().copied().collect();
-        if cav
-            .tets
-            .iter()
-            .any(|&s| self.tets[s as usize].iter().any(|v| !on_shell.contains(v)))
-        {
-            return None;
-        }
+        let (cav, on_shell) = self.cavity_of_shell_points(tets)?;
         let (x, cone_ok) = self.best_point(t, &cav.tets, &cav.shell, thr)?;
         let old = judge(self, &cav.tets, thr);
         let old_tets: Vec<[u32; 4]> = cav.tets.iter().map(|&s| self.tets[s as usize]).collect();

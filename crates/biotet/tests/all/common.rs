@@ -102,6 +102,17 @@ pub fn two_cubes() -> TetMesh {
 
 /// Read a binary STL from `tests/data` of the repository (welded by exact coordinates), as one
 /// closed region.
+/// TetGen's `pq1.2Y` mesh of brain_20k, bundled in `examples/`.
+pub fn tetgen_brain() -> TetMesh {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/brain_tetgen.node"
+    );
+    biotet_io::read_tet_mesh(std::path::Path::new(path))
+        .expect("examples/brain_tetgen.node")
+        .mesh
+}
+
 pub fn load_stl(name: &str) -> SurfaceMesh {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../tests/data/");
     let data = std::fs::read(format!("{path}{name}")).expect("test data");

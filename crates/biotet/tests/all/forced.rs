@@ -1,6 +1,6 @@
 //! Forced tets: poor because the input surface makes them so.
 
-use crate::common::{cube_surface, cube6, load_stl};
+use crate::common::{cube_surface, cube6, load_stl, tetgen_brain};
 use biotet::SurfaceMesh;
 use biotet::TetMesh;
 use biotet::quality::forced::{Placement, classify, placement_quality, summarise};
@@ -43,13 +43,7 @@ fn a_needle_triangle_and_a_sharp_fold_force_their_tets() {
 
 #[test]
 fn the_tetgen_brain_mesh_has_forced_tets_from_marching_cubes() {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../examples/brain_tetgen.node"
-    );
-    let m = biotet_io::read_tet_mesh(std::path::Path::new(path))
-        .unwrap()
-        .mesh;
+    let m = tetgen_brain();
     let s = load_stl("brain_20k.stl");
     let f = classify(&m, &s, 10.0);
     let sum = summarise(&m, &f, 10.0);

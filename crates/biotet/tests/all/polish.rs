@@ -1,7 +1,7 @@
 //! Polish: the last pass over the unforced tets below 10° (moves and removals of interior
 //! points), on a synthetic sliver and on TetGen's brain mesh.
 
-use crate::common::{load_stl, octahedron, orient_all};
+use crate::common::{load_stl, octahedron, orient_all, tetgen_brain};
 use biotet::check::check;
 use biotet::geom::predicates::{Sign, orient3d};
 use biotet::polish::{PolishOptions, polish};
@@ -53,13 +53,7 @@ fn polish_moves_the_interior_point_of_a_sliver() {
 /// triangle, the volume, and passes the checker.
 #[test]
 fn polish_improves_the_tetgen_brain_mesh() {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../examples/brain_tetgen.node"
-    );
-    let mut m = biotet_io::read_tet_mesh(std::path::Path::new(path))
-        .unwrap()
-        .mesh;
+    let mut m = tetgen_brain();
     let surface = load_stl("brain_20k.stl");
     let unforced_bad = |m: &TetMesh| {
         let f = classify(m, &surface, 10.0);
@@ -116,13 +110,7 @@ fn polish_improves_the_tetgen_brain_mesh() {
 /// bit (the scan's measures run in parallel), and a valid mesh.
 #[test]
 fn polish_is_the_same_on_any_number_of_threads() {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../examples/brain_tetgen.node"
-    );
-    let base = biotet_io::read_tet_mesh(std::path::Path::new(path))
-        .unwrap()
-        .mesh;
+    let base = tetgen_brain();
     let run = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
@@ -211,13 +199,7 @@ fn polish_inserts_a_point_into_a_sliver_with_four_surface_corners() {
 /// mesh with every surface triangle.
 #[test]
 fn polish_fixes_wedges_at_short_edges_of_the_tetgen_brain_mesh() {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../examples/brain_tetgen.node"
-    );
-    let base = biotet_io::read_tet_mesh(std::path::Path::new(path))
-        .unwrap()
-        .mesh;
+    let base = tetgen_brain();
     let surface = load_stl("brain_20k.stl");
     let below = |m: &TetMesh, deg: f64| (0..m.tets.len()).filter(|&t| min_deg(m, t) < deg).count();
     let run = |wedge: bool| {

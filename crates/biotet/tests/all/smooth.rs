@@ -1,7 +1,7 @@
 //! Solid-angle smoothing (chapter 4): the analytic gradient, the ascent direction, and the
 //! smoother's guarantees on synthetic and real meshes (TetGen's and biotet's brain meshes).
 
-use crate::common::{cube_surface, load_stl};
+use crate::common::{cube_surface, load_stl, tetgen_brain};
 use biotet::check::check;
 use biotet::delaunay::Delaunay;
 use biotet::geom::predicates::{Sign, orient3d};
@@ -498,16 +498,6 @@ fn two_regions_keep_their_interface_fixed() {
 // ------------------------------------------------------------------------------------------------
 // Real meshes
 // ------------------------------------------------------------------------------------------------
-
-fn tetgen_brain() -> TetMesh {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../examples/brain_tetgen.node"
-    );
-    biotet_io::read_tet_mesh(std::path::Path::new(path))
-        .expect("examples/brain_tetgen.node")
-        .mesh
-}
 
 fn biotet_brain(h: f64) -> (SurfaceMesh, TetMesh) {
     let s = load_stl("brain_20k.stl");
