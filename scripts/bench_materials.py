@@ -25,22 +25,22 @@ from benchlib import ROOT, median as med  # noqa: E402
 BIOTET = benchlib.find_biotet()
 DATA = os.path.join(ROOT, "tests", "data")
 NESTED = os.path.join(DATA, "nested_brain_wm_20k.stl")
+# (name, surface, labels): the labels as `--label`, for `mesh` and `check` alike.
 CASES = [
-    ("brain_20k (one region)", [os.path.join(DATA, "brain_20k.stl")]),
-    ("wm_20k (one region)", [os.path.join(DATA, "wm_20k.stl")]),
-    ("grey matter, white matter a hole (one region)", [NESTED, "--label", "nested_brain_wm_20k.stl=1,0"]),
-    ("nested brain + white matter (two regions)", [NESTED]),
+    ("brain_20k (one region)", os.path.join(DATA, "brain_20k.stl"), []),
+    ("wm_20k (one region)", os.path.join(DATA, "wm_20k.stl"), []),
+    ("grey matter, white matter a hole (one region)", NESTED, ["--label", "nested_brain_wm_20k.stl=1,0"]),
+    ("nested brain + white matter (two regions)", NESTED, []),
 ]
 
 
-def run(args, out, repeat, threads):
+def run(surface, labels, out, repeat, threads):
     pre = ["--threads", str(threads)] if threads else []
     rows = []
     for _ in range(repeat):
-        j = benchlib.biotet_json(BIOTET, *pre, "mesh", *args, "-o", out, "--quiet")
+        j = benchlib.biotet_json(BIOTET, *pre, "mesh", surface, *labels, "-o", out, "--quiet")
         p = j["pipeline"]
         rows.append({"seconds": p["seconds_total"] + j.get("seconds_sizing", 0.0), "tets": p["n_tets"],
-                     "regions": len({s["label"] for s in j.get("shells", []) if s["label"] != 0}),
                      "stages": {st["name"]: st["seconds"] for st in p["stages"]},
                      "unforced_lt10": j.get("forcing", {}).get("n_unforced_dihedral_lt_10")})
     stages = {n: med([{"s": r["stages"][n]} for r in rows], "s") for n in rows[0]["stages"]}
@@ -48,10 +48,8 @@ def run(args, out, repeat, threads):
             "unforced_lt10": rows[0]["unforced_lt10"]}
 
 
-def check(out, args):
-    surface = [a for a in args if not a.startswith("--") and "=" not in a]
-    extra = [a for a in args if a not in surface]
-    c = benchlib.biotet_json(BIOTET, "check", out, "--surface", *surface, *extra)
+def check(out, surface, labels):
+    c = benchlib.biotet_json(BIOTET, "check", out, "--surface", surface, *labels)
     return bool(c.get("valid"))
 
 
@@ -61,15 +59,14 @@ def main():
     ap.add_argument("--threads", type=int, default=0, help="biotet --threads (0: all cores)")
     ap.add_argument("--json")
     a = ap.parse_args()
-    if not os.path.exists(BIOTET):
-        sys.exit(f"{BIOTET} not found: cargo build --release -p biotet-cli")
+    benchlib.require(BIOTET)
     results = []
     with tempfile.TemporaryDirectory() as tmp:
-        for name, args in CASES:
+        for name, surface, labels in CASES:
             out = os.path.join(tmp, "out.vtu")
-            r = run(args, out, a.repeat, a.threads)
+            r = run(surface, labels, out, a.repeat, a.threads)
             r["case"] = name
-            r["valid"] = check(out, args)
+            r["valid"] = check(out, surface, labels)
             results.append(r)
     tissues = results[1:3]
     parts = {"case": "tissues one by one (grey + white, added)", "seconds": sum(r["seconds"] for r in tissues),

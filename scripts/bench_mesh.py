@@ -97,8 +97,7 @@ def main():
     ap.add_argument("--scaling", action="store_true")
     ap.add_argument("--json")
     a = ap.parse_args()
-    if not os.path.exists(BIOTET):
-        sys.exit(f"{BIOTET} not found: cargo build --release -p biotet-cli")
+    benchlib.require(BIOTET)
     results = []
     with tempfile.TemporaryDirectory() as tmp:
         for s in a.surfaces:

@@ -35,6 +35,12 @@ def find_biotet(path=None):
     return os.path.join(target, "release", "biotet")
 
 
+def require(exe, hint="cargo build --release -p biotet-cli"):
+    """Exit with a clear message when the biotet binary is missing."""
+    if not os.path.exists(exe):
+        sys.exit(f"{exe} not found: {hint}")
+
+
 def biotet_json(exe, *args, ok=(0, 1)):
     """Run `biotet ARGS --json` and return its JSON object (exit 1, an invalid mesh, still reports)."""
     r = subprocess.run([exe, *args, "--json"], capture_output=True, text=True)

@@ -1404,7 +1404,7 @@ impl<'a> Recovery<'a> {
             if batch.is_empty() {
                 break;
             }
-            // To the mesh's capacity, which grows by an eighth: few reallocations.
+            // To the mesh's capacity, which grows by a 32nd: few reallocations.
             let (nt, np) = (self.mesh.tets.capacity(), self.mesh.points.len());
             pool.push(Mutex::new(std::mem::take(&mut self.work)));
             for w in &mut pool {
@@ -1754,8 +1754,6 @@ impl<'a> Recovery<'a> {
                 k += 1;
             }
         }
-        // The per-tet scratch is rebuilt by `index`: freed first, so old and new never meet.
-        self.free_scratch();
         for t in 0..before {
             let new = index[t];
             if new == NO_NEIGHBOR {
@@ -1794,8 +1792,8 @@ impl<'a> Recovery<'a> {
     /// [`Self::is_present`] for the output. Returns (tets removed, regions with conflicting
     /// votes).
     fn relabel(&mut self) -> (usize, usize) {
-        // The surface triangle at each tet face (`NO_NEIGHBOR`: none), looked up in parallel.
-        // One bit a face (a byte a tet, not 16): the few walls are looked up again when met.
+        // Which tet faces are surface triangles, looked up in parallel: one bit a face (a byte a
+        // tet, not 16), the few walls looked up again when met.
         let view = self.view();
         let walls: Vec<u8> = (0..self.mesh.tets.len())
             .into_par_iter()

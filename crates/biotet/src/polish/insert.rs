@@ -2,7 +2,8 @@
 //!
 //! The cavity is the tet and its unforced face neighbours of the same label, or, when that fails,
 //! every unforced tet of its label sharing an edge with it, or else the face cavity with its
-//! unforced face neighbours of the label (a cavity with an interior point is not tried). Boundary and interface faces are never crossed, so they stay on the cavity's shell.
+//! unforced face neighbours of the label (a cavity with an interior point is not tried).
+//! Boundary and interface faces are never crossed, so they stay on the cavity's shell.
 //! The candidates are the tet's centroid and circumcentre, the centroids of the cavity's tets, the
 //! midpoints between the tet's centroid and theirs, the shell's vertex centroid, and points pushed
 //! into the shell's kernel from the two centroids (cyclic projection, floating point).
@@ -104,8 +105,9 @@ impl Work {
     /// `cd` sees both `a` and `b` keeps it. One point in front of `ab`, four times its length
     /// towards `cd`, with the stars of `a` and `b` refilled around it, can give `ab` a ring of
     /// near points. The search fills the stars with it as the one inner point (every tet above
-    /// the threshold, then, with `lower`, above the cavity's worst); kept only if the cavity's worst unforced
-    /// angle rises, its worst does not fall and fewer of its tets are below the threshold.
+    /// the threshold, then, with `lower`, above the cavity's worst); kept only if the cavity's
+    /// worst unforced angle rises, its worst does not fall and fewer of its tets are below the
+    /// threshold.
     pub fn insert_wedge(
         &mut self,
         t: u32,
@@ -203,10 +205,8 @@ impl Work {
         out
     }
 
-    /// Whether `x` is strictly inside one of `tets` (exact).
-    /// The cavity of `tets`, if every corner of its tets is on its shell (an inner point would
-    /// be lost: the refill takes the new point as its only inner point).
-    /// Also returns the shell's points.
+    /// The cavity of `tets` and its shell's points, if every corner of its tets is on its shell
+    /// (an inner point would be lost: the refill takes the new point as its only inner point).
     fn cavity_of_shell_points(&self, tets: Vec<u32>) -> Option<(Cavity, FxHashSet<u32>)> {
         let cav = self.cavity(tets);
         let on_shell: FxHashSet<u32> = cav.shell.iter().flatten().copied().collect();
@@ -217,6 +217,7 @@ impl Work {
         (!lost).then_some((cav, on_shell))
     }
 
+    /// Whether `x` is strictly inside one of `tets` (exact).
     fn strictly_inside(&self, tets: &[u32], x: P3) -> bool {
         tets.iter().any(|&s| {
             let c = self.corners(s);
