@@ -129,8 +129,11 @@ pub fn run(a: Args) -> Result<ExitCode> {
         );
         if let (Some(b), Some(f)) = (&forced_before, &forced_after) {
             text += &format!(
-                "\nforced by the input: {} tets; unforced tets below 10°: {} → {}",
-                f.n_forced, b.n_unforced_dihedral_lt_10, f.n_unforced_dihedral_lt_10
+                "\nforced by the input: {} tets; unforced tets below 10°: {} → {} ({})",
+                f.n_forced,
+                b.n_unforced_dihedral_lt_10,
+                f.n_unforced_dihedral_lt_10,
+                f.cause_text()
             );
         }
         crate::emit(&text);

@@ -316,8 +316,10 @@ pub fn run(a: Args) -> Result<ExitCode> {
         );
         text += &format!(
             "\nforced by the input (a face or fold under {FORCED_DEG}°): {} tets; unforced tets \
-             below 10°: {}",
-            forcing.n_forced, forcing.n_unforced_dihedral_lt_10
+             below 10°: {} ({})",
+            forcing.n_forced,
+            forcing.n_unforced_dihedral_lt_10,
+            forcing.cause_text()
         );
         crate::emit(&text);
     }

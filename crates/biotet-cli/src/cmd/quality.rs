@@ -119,8 +119,10 @@ fn print_placement(
         }
         text += &format!(
             "forced by the input (a face or fold under {FORCED_DEG}°): {} tets; unforced tets \
-             below 10°: {}",
-            forcing.n_forced, forcing.n_unforced_dihedral_lt_10
+             below 10°: {} ({})",
+            forcing.n_forced,
+            forcing.n_unforced_dihedral_lt_10,
+            forcing.cause_text()
         );
         crate::emit(&text);
     }

@@ -39,6 +39,28 @@ pub struct Forcing {
     pub placement: Vec<Placement>,
     /// Whether each tet is forced poor by the input.
     pub forced: Vec<bool>,
+    /// Per mesh point: a corner of an input triangle with an angle below the threshold.
+    pub poor_corner: Vec<bool>,
+    /// The edges (mesh points, smaller first, sorted) of input triangles with an angle below
+    /// the threshold.
+    pub poor_edges: Vec<[u32; 2]>,
+}
+
+impl Forcing {
+    /// Why an unforced tet with corners `tet` and its smallest dihedral angle at local edge `e`
+    /// may still be poor: 0 when the opposite edge (the short edge of a wedge) is an edge of a
+    /// poor input triangle, 1 when a corner is on one, 2 otherwise.
+    pub fn cause(&self, tet: [u32; 4], e: usize) -> usize {
+        let [i, j] = TET_EDGES[5 - e];
+        let (a, b) = (tet[i], tet[j]);
+        if self.poor_edges.binary_search(&[a.min(b), a.max(b)]).is_ok() {
+            0
+        } else if tet.iter().any(|&v| self.poor_corner[v as usize]) {
+            1
+        } else {
+            2
+        }
+    }
 }
 
 /// Counts of [`classify`], with the quality of the unforced tets.
@@ -66,6 +88,21 @@ pub struct ForcingSummary {
     pub unforced_min_dihedral_deg: Option<f64>,
     /// Tets below 10° by placement: `[face, vertex, interior]`.
     pub dihedral_lt_10_by_placement: [usize; 3],
+    /// Unforced tets below 10° by what bounds them (see [`Forcing::cause`]): `[the edge opposite
+    /// their smallest angle is an edge of a poor input triangle, a corner is on a poor input
+    /// triangle, neither]`.
+    pub unforced_lt_10_by_cause: [usize; 3],
+}
+
+impl ForcingSummary {
+    /// The unforced tets under 10° by cause, for a report line: `"109 opposite an edge of a
+    /// poor input triangle, 48 with a corner on one, 1 neither"`.
+    pub fn cause_text(&self) -> String {
+        let [e, c, o] = self.unforced_lt_10_by_cause;
+        format!(
+            "{e} opposite an edge of a poor input triangle, {c} with a corner on one, {o} neither"
+        )
+    }
 }
 
 #[inline]
@@ -151,7 +188,40 @@ pub fn classify(mesh: &TetMesh, surface: &SurfaceMesh, threshold_deg: f64) -> Fo
         placement.push(place);
         forced.push(is_forced);
     }
-    Forcing { placement, forced }
+    let mut poor_corner = vec![false; mesh.points.len()];
+    let mut poor_edges = Vec::new();
+    let mesh_of = {
+        let mut m = vec![u32::MAX; surface.points.len()];
+        for (v, &sv) in surf_of.iter().enumerate() {
+            if sv != u32::MAX {
+                m[sv as usize] = v as u32;
+            }
+        }
+        m
+    };
+    for (t, tri) in surface.triangles.iter().enumerate() {
+        if !poor[t] {
+            continue;
+        }
+        let v = tri.map(|x| mesh_of[x as usize]);
+        for k in 0..3 {
+            let (a, b) = (v[k], v[(k + 1) % 3]);
+            if a != u32::MAX {
+                poor_corner[a as usize] = true;
+            }
+            if a != u32::MAX && b != u32::MAX {
+                poor_edges.push([a.min(b), a.max(b)]);
+            }
+        }
+    }
+    poor_edges.sort_unstable();
+    poor_edges.dedup();
+    Forcing {
+        placement,
+        forced,
+        poor_corner,
+        poor_edges,
+    }
 }
 
 /// Whether the surface triangles at an edge `(c[i], c[j])` form, around the tet, a wedge whose
@@ -209,11 +279,13 @@ pub fn summarise(mesh: &TetMesh, f: &Forcing, threshold_deg: f64) -> ForcingSumm
         ..ForcingSummary::default()
     };
     for t in 0..mesh.tets.len() {
-        let m = dihedral_angles(&mesh.corners(t))
-            .iter()
-            .copied()
-            .fold(f64::INFINITY, f64::min)
-            .to_degrees();
+        let angles = dihedral_angles(&mesh.corners(t));
+        let (e, m) =
+            angles.iter().enumerate().fold(
+                (0, f64::INFINITY),
+                |b, (e, &a)| if a < b.1 { (e, a) } else { b },
+            );
+        let m = m.to_degrees();
         let slot = match f.placement[t] {
             Placement::Face => {
                 s.n_face += 1;
@@ -237,6 +309,9 @@ pub fn summarise(mesh: &TetMesh, f: &Forcing, threshold_deg: f64) -> ForcingSumm
         } else {
             s.n_unforced_dihedral_lt_5 += usize::from(m < 5.0);
             s.n_unforced_dihedral_lt_10 += usize::from(m < 10.0);
+            if m < 10.0 {
+                s.unforced_lt_10_by_cause[f.cause(mesh.tets[t], e)] += 1;
+            }
             s.n_unforced_dihedral_lt_20 += usize::from(m < 20.0);
             s.unforced_min_dihedral_deg = Some(s.unforced_min_dihedral_deg.map_or(m, |x| x.min(m)));
         }

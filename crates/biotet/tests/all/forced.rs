@@ -70,6 +70,41 @@ fn the_tetgen_brain_mesh_has_forced_tets_from_marching_cubes() {
         classes.map(|c| c.n_dihedral_lt_10),
         sum.dihedral_lt_10_by_placement
     );
+    // What bounds the unforced tets under 10°: mostly a poor input triangle next to them.
+    assert_eq!(
+        sum.unforced_lt_10_by_cause.iter().sum::<usize>(),
+        sum.n_unforced_dihedral_lt_10
+    );
+    assert!(sum.unforced_lt_10_by_cause[0] > 0, "{sum:?}");
+    // Recomputed from the surface alone: a tet of the first cause has, opposite its smallest
+    // dihedral angle, an edge of an input triangle with an angle under 10°.
+    let key = |p: [f64; 3]| p.map(f64::to_bits);
+    let mut poor_edges = std::collections::HashSet::new();
+    for t in &s.triangles {
+        let c = t.map(|v| s.points[v as usize]);
+        if biotet::quality::tri::min_angle_3d_deg(&c) < 10.0 {
+            for k in 0..3 {
+                let (a, b) = (key(c[k]), key(c[(k + 1) % 3]));
+                poor_edges.insert((a.min(b), a.max(b)));
+            }
+        }
+    }
+    let mut first = 0;
+    for (t, tet) in m.tets.iter().enumerate() {
+        let a = biotet::quality::tet::dihedral_angles(&m.corners(t));
+        let e = (0..6).min_by(|&i, &j| a[i].total_cmp(&a[j])).unwrap();
+        if f.forced[t] || a[e].to_degrees() >= 10.0 || f.cause(*tet, e) != 0 {
+            continue;
+        }
+        let [i, j] = biotet::mesh::tet::TET_EDGES[5 - e];
+        let (p, q) = (
+            key(m.points[tet[i] as usize]),
+            key(m.points[tet[j] as usize]),
+        );
+        assert!(poor_edges.contains(&(p.min(q), p.max(q))), "tet {t}");
+        first += 1;
+    }
+    assert_eq!(first, sum.unforced_lt_10_by_cause[0]);
     // Forced tets touch the surface; every class of this mesh is populated and measured.
     assert_eq!(pq.interior.n_forced, 0);
     for c in classes {
