@@ -29,16 +29,6 @@ DEFAULT = os.path.join(ROOT, "tests", "data", "brain_20k.stl")
 SEED = [("seed, breast", 148, 104, "1.08–1.22"), ("seed, brain", 310, 241, "1.08–1.22")]
 
 
-def quality(mesh, surface):
-    q = benchlib.biotet_json(BIOTET, "quality", mesh, "--surface", surface, ok=(0,))
-    c = benchlib.biotet_json(BIOTET, "check", mesh, "--surface", surface)
-    f = q.get("forcing") or {}
-    return {"tets": q["n_tets"], "min_dihedral": q["min_dihedral_deg"], "lt5": q["n_dihedral_lt_5"],
-            "lt10": q["n_dihedral_lt_10"], "lt20": q["n_dihedral_lt_20"],
-            "unforced_lt10": f.get("n_unforced_dihedral_lt_10"), "cause": f.get("unforced_lt_10_by_cause"),
-            "valid": bool(c.get("valid"))}
-
-
 def improve(mesh, surface, out, repeat):
     rows = [benchlib.biotet_json(BIOTET, "improve", mesh, "--surface", surface, "-o", out, "--quiet")
             for _ in range(repeat)]
@@ -49,7 +39,7 @@ def improve(mesh, surface, out, repeat):
             "unforced_before": j["forcing_before"]["n_unforced_dihedral_lt_10"],
             "unforced_after": j["forcing_after"]["n_unforced_dihedral_lt_10"],
             "cause_after": j["forcing_after"].get("unforced_lt_10_by_cause"),
-            "check": quality(out, surface)}
+            "valid": benchlib.measure(BIOTET, out, surface)["valid"]}
 
 
 def main():
@@ -74,9 +64,9 @@ def main():
             except RuntimeError as e:
                 print(f"pip tetgen {sw} skipped: {e}", file=sys.stderr)
                 continue
-            made.append({"tool": f"TetGen {sw}", **quality(base + ".node", s)})
+            made.append({"tool": f"TetGen {sw}", **benchlib.measure(BIOTET, base + ".node", s)})
             meshes.append((f"TetGen {sw}", base + ".node"))
-        made.append({"tool": "biotet mesh (defaults)", **quality(full, s)})
+        made.append({"tool": "biotet mesh (defaults)", **benchlib.measure(BIOTET, full, s)})
         for name, mesh in meshes:
             r = improve(mesh, s, os.path.join(tmp, "improved.vtu"), a.repeat)
             r["mesh"] = name
@@ -92,7 +82,7 @@ def main():
               f"| {b['lt_20']:,} → {f['lt_20']:,} | {r['unforced_before']:,} → {r['unforced_after']:,} "
               f"| {r['calls']:,} | {r['ms_median']:.4f} | {r['seconds'] / r['calls'] * 1e3:.4f} | {r['ms_max']:.1f} "
               f"| {r['seconds']:.3f} | {r['seconds'] / b['lt_10'] * 1e3:.3f} | {r['cause_after']} "
-              f"| {r['check']['valid']} |")
+              f"| {r['valid']} |")
     for n, sl, calls, per in SEED:
         print(f"| {n} (Table 3.2) | | {sl} | | | {calls} | | | | | {per} s | | |")
     print(f"\nMeshes as the tools leave them ({name}):\n")
@@ -100,7 +90,7 @@ def main():
     print("|---|---|---|---|---|---|---|---|---|")
     for r in made:
         print(f"| {r['tool']} | {r['tets']:,} | {r['min_dihedral']:.4f} | {r['lt5']:,} | {r['lt10']:,} "
-              f"| {r['lt20']:,} | {r['unforced_lt10']:,} | {r['cause']} | {r['valid']} |")
+              f"| {r['lt20']:,} | {r['unforced_lt10']:,} | {r['unforced_cause']} | {r['valid']} |")
     if a.json:
         with open(a.json, "w") as fh:
             json.dump({"surface": name, "improved": improved, "meshes": made}, fh, indent=1)

@@ -64,6 +64,7 @@ def measure(exe, mesh, surface):
         "missing": conf["n_triangles"] - conf["n_found"] if conf else None,
         "valid": c.get("valid"),
         "forced": q.get("n_forced"), "unforced_lt10": q.get("n_unforced_dihedral_lt_10"),
+        "unforced_cause": (q.get("forcing") or {}).get("unforced_lt_10_by_cause"),
     }
     for cls in ("face", "vertex", "interior"):
         p = place.get(cls) or {}
