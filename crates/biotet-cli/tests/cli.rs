@@ -769,7 +769,7 @@ fn recover_then_improve_a_mesh_made_without_them() {
     assert_eq!(j["complete"], true, "{j}");
     assert!(j["recover"]["missing_before"].as_u64().unwrap() > 100);
     assert_eq!(j["recover"]["missing_after"], 0);
-    assert_eq!(j["recover"]["points_added"], 0);
+    assert_eq!(j["recover"]["steiner_points"], 0);
     let c = biotet(&["check", s(&rec), "--surface", s(&brain), "--json"]);
     let cj: Value = serde_json::from_slice(&c.stdout).unwrap();
     assert_eq!(cj["valid"], true, "{cj}");

@@ -95,7 +95,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
             report.cavities_grown,
             report.call_ms_median,
             report.call_ms_max,
-            report.points_added,
+            report.steiner_points,
             report.outside_tets_removed,
             report.total_ms / 1e3,
         );

@@ -203,8 +203,9 @@ pub struct RecoverReport {
     pub nodes_total: u64,
     /// Median number of tets carved per call.
     pub cavity_tets_median: usize,
-    /// Points added strictly inside cavities (only with `allow_interior_steiner`).
-    pub points_added: usize,
+    /// Steiner points added strictly inside the domain (never on the surface) where no fill of a
+    /// cavity with the existing points was found (only with `allow_interior_steiner`).
+    pub steiner_points: usize,
     /// Tets of region 0 removed at the end.
     pub outside_tets_removed: usize,
     /// Regions whose surrounding surface triangles disagree about their label (left as they
@@ -334,7 +335,7 @@ fn recover_checked(
         nodes_max: nodes.last().copied().unwrap_or(0),
         nodes_total: nodes.iter().sum(),
         cavity_tets_median: sizes.get(sizes.len() / 2).copied().unwrap_or(0),
-        points_added: r.points_added,
+        steiner_points: r.steiner_points,
         outside_tets_removed: removed,
         label_conflicts: conflicts,
         total_ms: t0.elapsed().as_secs_f64() * 1e3,
@@ -446,7 +447,7 @@ struct Recovery<'a> {
     crossed_tried: usize,
     crossed_ok: usize,
     grown: usize,
-    points_added: usize,
+    steiner_points: usize,
 }
 
 /// Stamped marks and buffers of the read-only stages (walks, carving, searches): one for the
@@ -1217,7 +1218,7 @@ impl<'a> Recovery<'a> {
             crossed_tried: 0,
             crossed_ok: 0,
             grown: 0,
-            points_added: 0,
+            steiner_points: 0,
         };
         r.index();
         r
@@ -1713,7 +1714,7 @@ impl<'a> Recovery<'a> {
             }
             let n0 = self.mesh.points.len();
             if self.attempt(s, v, Some(())) {
-                self.points_added += self.mesh.points.len() - n0;
+                self.steiner_points += self.mesh.points.len() - n0;
                 self.reason.remove(&s);
             }
         }

@@ -592,7 +592,7 @@ fn recover_fails_honestly_on_schoenhardt() {
         assert!(u.min_angle_deg > 0.0);
         assert_eq!(u.corners, s.corners(u.triangle));
     }
-    assert_eq!(r.points_added, 0);
+    assert_eq!(r.steiner_points, 0);
     assert_eq!(m.points.len(), 6);
     // With one interior point allowed, it is recovered.
     let mut m = Delaunay::new(&p).unwrap().to_tet_mesh();
@@ -602,7 +602,7 @@ fn recover_fails_honestly_on_schoenhardt() {
     };
     let r = recover(&mut m, &s, &opts).unwrap();
     assert!(r.is_complete(), "{r:?}");
-    assert_eq!(r.points_added, 1);
+    assert_eq!(r.steiner_points, 1);
     assert_eq!(m.points.len(), 7);
     let c = check(&m, Some(&s));
     assert!(c.valid, "{c}");
