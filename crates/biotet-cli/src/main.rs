@@ -8,6 +8,7 @@
 
 mod cmd;
 mod memory;
+mod output;
 mod plot;
 mod progress;
 

@@ -56,6 +56,11 @@ struct Panel<'a> {
 /// (written to a temporary file next to it, then renamed). `title` heads the picture, e.g. the
 /// mesh's file name.
 pub fn write_quality_svg(report: &QualityReport, path: &Path, title: &str) -> Result<()> {
+    write_svg(path, &quality_svg(report, title)?)
+}
+
+/// The SVG text of [`write_quality_svg`].
+pub fn quality_svg(report: &QualityReport, title: &str) -> Result<String> {
     let r = report;
     let regular_dihedral = (1.0f64 / 3.0).acos().to_degrees();
     let mut notes = vec![format!(
@@ -115,12 +120,17 @@ pub fn write_quality_svg(report: &QualityReport, path: &Path, title: &str) -> Re
         )],
         notes,
     };
-    write_svg(path, title, [&dihedral, &solid], draw_panel)
+    render(title, [&dihedral, &solid], draw_panel)
 }
 
 /// Draw the angle and minimum-angle histograms of a 2D triangle mesh's report to an SVG file at
 /// `path` (written to a temporary file next to it, then renamed). `title` heads the picture.
 pub fn write_tri_quality_svg(report: &TriQualityReport, path: &Path, title: &str) -> Result<()> {
+    write_svg(path, &tri_quality_svg(report, title)?)
+}
+
+/// The SVG text of [`write_tri_quality_svg`].
+pub fn tri_quality_svg(report: &TriQualityReport, title: &str) -> Result<String> {
     let r = report;
     let angles = Panel {
         caption: "Angles (3 per triangle, 10° bins)".into(),
@@ -164,20 +174,18 @@ pub fn write_tri_quality_svg(report: &TriQualityReport, path: &Path, title: &str
             ),
         ],
     };
-    write_svg(path, title, [&angles, &min_angles], draw_panel)
+    render(title, [&angles, &min_angles], draw_panel)
 }
 
-/// Draw the dihedral- and solid-angle histograms of a mesh before and after smoothing, overlaid
-/// (before as a grey outline, after as filled bars; dissertation figs. 4.8 and 4.9) to an SVG
-/// file at `path` (written to a temporary file next to it, then renamed).
-/// `below_02` is the share of solid angles under 0.2 sr before and after.
-pub fn write_smooth_svg(
+/// The SVG text of the dihedral- and solid-angle histograms of a mesh before and after
+/// smoothing, overlaid (before as a grey outline, after as filled bars; dissertation figs. 4.8
+/// and 4.9). `below_02` is the share of solid angles under 0.2 sr before and after.
+pub fn smooth_svg(
     before: &QualityReport,
     after: &QualityReport,
     below_02: (f64, f64),
-    path: &Path,
     title: &str,
-) -> Result<()> {
+) -> Result<String> {
     let regular_dihedral = (1.0f64 / 3.0).acos().to_degrees();
     let dihedral = Overlay {
         caption: "Dihedral angles before and after (10° bins)".into(),
@@ -231,10 +239,10 @@ pub fn write_smooth_svg(
             ),
         ],
     };
-    write_svg(path, title, [&dihedral, &solid], draw_overlay)
+    render(title, [&dihedral, &solid], draw_overlay)
 }
 
-/// One panel of [`write_smooth_svg`]: two histograms with the same bins.
+/// One panel of [`smooth_svg`]: two histograms with the same bins.
 struct Overlay<'a> {
     caption: String,
     x_desc: &'a str,
@@ -498,15 +506,9 @@ fn draw_panel(area: &Area, p: &Panel) -> Result<()> {
     draw_legend(&mut chart)
 }
 
-/// Render, then write through a temporary file in the target's directory and rename it into
-/// place, so the target is either the old file or the whole new one.
-fn write_svg<P>(
-    path: &Path,
-    title: &str,
-    panels: [&P; 2],
-    draw: fn(&Area, &P) -> Result<()>,
-) -> Result<()> {
-    let svg = render(title, panels, draw)?;
+/// Write through a temporary file in the target's directory and rename it into place, so the
+/// target is either the old file or the whole new one.
+fn write_svg(path: &Path, svg: &str) -> Result<()> {
     biotet_io::atomic::write_atomic(path, |w| {
         w.write_all(svg.as_bytes())
             .map_err(|e| biotet_io::Error::io(&path.display().to_string(), e))

@@ -1149,3 +1149,289 @@ fn bad_side_labels_name_the_file_and_the_triangle() {
     std::fs::write(&p, text).unwrap();
     refused(&p, "intersect");
 }
+
+/// A unit cube whose face diagonals admit no tetrahedralization of its eight corners (trimesh's
+/// `creation.box`): meshing it needs a Steiner point inside. No interior node is deployed at the
+/// default size, so `--no-steiner` makes recovery fail.
+fn twisted_cube_off() -> String {
+    cube_off(|tris, pts| {
+        *pts = (0..8)
+            .map(|i| [(i >> 2) as f64, ((i >> 1) & 1) as f64, (i & 1) as f64])
+            .collect();
+        *tris = vec![
+            [1, 3, 0],
+            [4, 1, 0],
+            [0, 3, 2],
+            [2, 4, 0],
+            [1, 7, 3],
+            [5, 1, 4],
+            [5, 7, 1],
+            [3, 7, 2],
+            [6, 4, 2],
+            [2, 7, 6],
+            [6, 5, 4],
+            [7, 5, 6],
+        ];
+    })
+}
+
+/// The files in `dir`, sorted.
+fn listing(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn a_failed_mesh_creates_and_replaces_nothing_and_keeps_the_partial_mesh_on_request() {
+    let dir = tempfile::tempdir().unwrap();
+    let cube = dir.path().join("cube.off");
+    std::fs::write(&cube, twisted_cube_off()).unwrap();
+    let out = dir.path().join("cube.vtu");
+    let svg = dir.path().join("cube.svg");
+    let failed = dir.path().join("cube.failed.vtu");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "mesh",
+            s(&cube),
+            "--no-steiner",
+            "-o",
+            s(&out),
+            "--svg",
+            s(&svg),
+        ];
+        args.extend_from_slice(extra);
+        biotet(&args)
+    };
+    // Nothing created: no output, no SVG, no partial mesh, no temporary file.
+    let r = run(&[]);
+    assert_eq!(r.status.code(), Some(1), "{}", stderr(&r));
+    let e = stderr(&r);
+    assert!(e.contains("could not be recovered"), "{e}");
+    assert!(
+        e.contains("was not written") || e.contains("were not written"),
+        "{e}"
+    );
+    assert!(
+        e.contains("--keep-failed") && e.contains("cube.failed.vtu"),
+        "{e}"
+    );
+    assert!(e.contains("without --no-steiner"), "{e}");
+    assert!(!e.contains("--allow-interior-steiner"), "{e}");
+    assert_eq!(listing(dir.path()), ["cube.off"]);
+    // Nothing replaced: files already there stay byte-identical, also with --quiet and --json.
+    std::fs::write(&out, b"the previous mesh").unwrap();
+    std::fs::write(&svg, b"the previous plot").unwrap();
+    for extra in [&[][..], &["--quiet"], &["--json"]] {
+        let r = run(extra);
+        assert_eq!(r.status.code(), Some(1), "{extra:?}");
+        assert!(stderr(&r).contains("was not written") || stderr(&r).contains("were not written"));
+        assert_eq!(std::fs::read(&out).unwrap(), b"the previous mesh");
+        assert_eq!(std::fs::read(&svg).unwrap(), b"the previous plot");
+        assert_eq!(listing(dir.path()), ["cube.off", "cube.svg", "cube.vtu"]);
+    }
+    // --keep-failed: the partial mesh beside the output, named in the message and the JSON.
+    let r = run(&["--keep-failed", "--json"]);
+    assert_eq!(r.status.code(), Some(1));
+    assert!(stderr(&r).contains(s(&failed)), "{}", stderr(&r));
+    let j: Value = serde_json::from_slice(&r.stdout).unwrap();
+    assert_eq!(j["written"], serde_json::json!([s(&failed)]), "{j}");
+    assert!(j["pipeline"]["missing_triangles"].as_u64().unwrap() > 0);
+    assert_eq!(j["pipeline"]["recover"]["steiner_points"], 0);
+    assert_eq!(std::fs::read(&out).unwrap(), b"the previous mesh");
+    assert_eq!(std::fs::read(&svg).unwrap(), b"the previous plot");
+    let c = biotet(&["check", s(&failed), "--surface", s(&cube), "--quiet"]);
+    assert_eq!(c.status.code(), Some(1), "the partial mesh lacks triangles");
+    // TetGen output: the three files of the base `cube_tg.failed`.
+    let tg = dir.path().join("cube_tg.node");
+    let r = biotet(&[
+        "mesh",
+        s(&cube),
+        "--no-steiner",
+        "-o",
+        s(&tg),
+        "--keep-failed",
+        "--quiet",
+    ]);
+    assert_eq!(r.status.code(), Some(1));
+    for ext in ["node", "ele", "face"] {
+        let f = dir.path().join(format!("cube_tg.failed.{ext}"));
+        assert!(f.exists(), "{}", f.display());
+        assert!(stderr(&r).contains(s(&f)), "{}", stderr(&r));
+        assert!(!dir.path().join(format!("cube_tg.{ext}")).exists());
+    }
+    // --keep-failed needs an output.
+    let r = biotet(&["mesh", s(&cube), "--keep-failed"]);
+    assert_eq!(r.status.code(), Some(2));
+}
+
+#[test]
+fn a_failed_recover_creates_and_replaces_nothing_and_keeps_the_partial_mesh_on_request() {
+    let dir = tempfile::tempdir().unwrap();
+    let cube = dir.path().join("cube.off");
+    std::fs::write(&cube, twisted_cube_off()).unwrap();
+    let points = dir.path().join("corners.xyz");
+    std::fs::write(
+        &points,
+        (0..8)
+            .map(|i| format!("{} {} {}\n", i >> 2, (i >> 1) & 1, i & 1))
+            .collect::<String>(),
+    )
+    .unwrap();
+    let dt = dir.path().join("dt.vtu");
+    assert!(
+        biotet(&["delaunay", s(&points), "-o", s(&dt), "-q"])
+            .status
+            .success()
+    );
+    let out = dir.path().join("rec.vtu");
+    let failed = dir.path().join("rec.failed.vtu");
+    let recover = |extra: &[&str]| {
+        let mut args = vec!["recover", s(&dt), "-s", s(&cube), "-o", s(&out)];
+        args.extend_from_slice(extra);
+        biotet(&args)
+    };
+    let r = recover(&["--no-steiner"]);
+    assert_eq!(r.status.code(), Some(1), "{}", stderr(&r));
+    let e = stderr(&r);
+    assert!(
+        e.contains("rec.vtu was not written") && e.contains("--keep-failed"),
+        "{e}"
+    );
+    assert!(e.contains("without --no-steiner"), "{e}");
+    assert!(!e.contains("--allow-interior-steiner"), "{e}");
+    assert!(!out.exists() && !failed.exists());
+    std::fs::write(&out, b"the previous mesh").unwrap();
+    let r = recover(&["--no-steiner", "--quiet"]);
+    assert_eq!(r.status.code(), Some(1));
+    assert!(stderr(&r).contains("was not written"), "{}", stderr(&r));
+    assert_eq!(std::fs::read(&out).unwrap(), b"the previous mesh");
+    let r = recover(&["--no-steiner", "--keep-failed", "--json"]);
+    assert_eq!(r.status.code(), Some(1));
+    assert!(stderr(&r).contains(s(&failed)), "{}", stderr(&r));
+    let j: Value = serde_json::from_slice(&r.stdout).unwrap();
+    assert_eq!(j["complete"], false);
+    assert_eq!(j["written"], serde_json::json!([s(&failed)]), "{j}");
+    assert_eq!(std::fs::read(&out).unwrap(), b"the previous mesh");
+    assert!(failed.exists());
+    assert_eq!(
+        listing(dir.path()),
+        [
+            "corners.xyz",
+            "cube.off",
+            "dt.vtu",
+            "rec.failed.vtu",
+            "rec.vtu"
+        ]
+    );
+}
+
+#[test]
+fn steiner_points_inside_mesh_the_twisted_cube_by_default() {
+    let dir = tempfile::tempdir().unwrap();
+    let cube = dir.path().join("cube.off");
+    std::fs::write(&cube, twisted_cube_off()).unwrap();
+    let out = dir.path().join("cube.vtu");
+    let j = json_of(&biotet(&["mesh", s(&cube), "-o", s(&out), "--json"]));
+    assert_eq!(j["pipeline"]["missing_triangles"], 0, "{j}");
+    let n = j["pipeline"]["recover"]["steiner_points"].as_u64().unwrap();
+    assert!(n >= 1, "{j}");
+    assert_eq!(j["written"], serde_json::json!([s(&out)]));
+    let c = biotet(&["check", s(&out), "--surface", s(&cube), "--quiet"]);
+    assert!(c.status.success(), "{}", stderr(&c));
+    // The text report says how many points were added, and where.
+    let r = biotet(&["mesh", s(&cube)]);
+    assert!(r.status.success(), "{}", stderr(&r));
+    let text = String::from_utf8_lossy(&r.stdout);
+    assert!(
+        text.contains(&format!(
+            "recover: {n} Steiner points added strictly inside (never on the surface)"
+        )),
+        "{text}"
+    );
+}
+
+#[test]
+fn allow_interior_steiner_is_still_accepted_and_the_default() {
+    let dir = tempfile::tempdir().unwrap();
+    let cube = dir.path().join("cube.off");
+    std::fs::write(&cube, twisted_cube_off()).unwrap();
+    let a = dir.path().join("a.vtu");
+    let b = dir.path().join("b.vtu");
+    let r = biotet(&["mesh", s(&cube), "-o", s(&a), "--quiet"]);
+    assert!(r.status.success(), "{}", stderr(&r));
+    let r = biotet(&[
+        "mesh",
+        s(&cube),
+        "-o",
+        s(&b),
+        "--allow-interior-steiner",
+        "--quiet",
+    ]);
+    assert!(r.status.success(), "{}", stderr(&r));
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+    // recover: the former opt-in gives the default's result.
+    let points = dir.path().join("corners.xyz");
+    std::fs::write(
+        &points,
+        (0..8)
+            .map(|i| format!("{} {} {}\n", i >> 2, (i >> 1) & 1, i & 1))
+            .collect::<String>(),
+    )
+    .unwrap();
+    let dt = dir.path().join("dt.vtu");
+    assert!(
+        biotet(&["delaunay", s(&points), "-o", s(&dt), "-q"])
+            .status
+            .success()
+    );
+    let mut results = Vec::new();
+    for extra in [&[][..], &["--allow-interior-steiner"]] {
+        let rec = dir.path().join(format!("rec{}.vtu", results.len()));
+        let mut args = vec!["recover", s(&dt), "-s", s(&cube), "-o", s(&rec), "--json"];
+        args.extend_from_slice(extra);
+        let j = json_of(&biotet(&args));
+        assert_eq!(j["complete"], true, "{extra:?}: {j}");
+        assert!(j["recover"]["steiner_points"].as_u64().unwrap() >= 1, "{j}");
+        results.push(std::fs::read(&rec).unwrap());
+    }
+    assert_eq!(results[0], results[1]);
+    // It contradicts --no-steiner.
+    for cmd in [
+        vec!["mesh", s(&cube), "--allow-interior-steiner", "--no-steiner"],
+        vec![
+            "recover",
+            s(&dt),
+            "-s",
+            s(&cube),
+            "-o",
+            s(&a),
+            "--allow-interior-steiner",
+            "--no-steiner",
+        ],
+    ] {
+        assert_eq!(biotet(&cmd).status.code(), Some(2), "{cmd:?}");
+    }
+}
+
+#[test]
+fn mesh_and_recover_help_end_with_examples_of_the_steiner_and_failure_flags() {
+    for cmd in ["mesh", "recover"] {
+        let out = biotet(&[cmd, "--help"]);
+        assert!(out.status.success());
+        let text = String::from_utf8_lossy(&out.stdout);
+        let examples = text.find("Examples:").expect("examples");
+        assert!(
+            text[examples..].contains("--no-steiner --keep-failed"),
+            "{text}"
+        );
+        assert!(text[examples..].contains(".failed.vtu"), "{text}");
+        assert!(text[..examples].contains("--no-steiner"), "{text}");
+        assert!(text[..examples].contains("--keep-failed"), "{text}");
+        // The former opt-in is accepted but not shown.
+        assert!(!text.contains("--allow-interior-steiner"), "{text}");
+    }
+}

@@ -1,7 +1,7 @@
 //! `biotet mesh`: surface in, volume mesh out (the whole pipeline).
 
 use crate::memory::{StagePeaks, map_mesh_sized_blocks, release_free_memory};
-use crate::{Common, plot, progress::Stage};
+use crate::{Common, output, plot, progress::Stage};
 use anyhow::{Context, Result, bail};
 use biotet::mesh::shells::Part;
 use biotet::pipeline::{PipelineOptions, mesh_surface};
@@ -9,7 +9,7 @@ use biotet::quality::{QualityReport, forced};
 use biotet::sizing::{SizeSpec, Sizing, SizingOptions};
 use biotet::template::Zone;
 use serde_json::json;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
@@ -27,9 +27,21 @@ enum ZoneArg {
     Euclidean,
 }
 
+/// Examples at the end of `biotet mesh --help`.
+const EXAMPLES: &str = "\
+Examples:
+  biotet mesh part.stl -o part.vtu --svg part.svg
+      Where no fill exists without new points (a twisted cube, a Schönhardt prism), recovery adds
+      Steiner points strictly inside the domain, never on the surface; the report counts them.
+  biotet mesh part.stl -o part.vtu --no-steiner --keep-failed
+      No new points at all (the seed's recovery alone). If a triangle then cannot be recovered,
+      the run exits 1, part.vtu is neither created nor replaced, and the partial mesh is written
+      to part.failed.vtu for inspection.";
+
 /// Arguments of `biotet mesh`.
 #[derive(clap::Args)]
 #[command(group(clap::ArgGroup::new("sizing").args(["size", "size_from_surface", "size_field"])))]
+#[command(after_help = EXAMPLES)]
 pub struct Args {
     /// Closed surfaces (.stl, .obj, .off, .ply, .mesh, .vtu). Every closed shell encloses a
     /// region; a point belongs to the innermost shell around it. Shells are labelled 1, 2, … in
@@ -42,9 +54,13 @@ pub struct Args {
     #[arg(long, value_name = "FILE=N[,N...]")]
     label: Vec<String>,
     /// Output tet mesh (.vtu, .mesh, .msh, .node/.ele). Without it, the mesh is built and
-    /// reported only.
+    /// reported only. A run that fails (exit 1) neither creates nor replaces it.
     #[arg(short, long, value_name = "OUT")]
     output: Option<PathBuf>,
+    /// When the run fails (input triangles left unrecovered), write the partial mesh beside the
+    /// output as OUT.failed.EXT for inspection (OUT itself is never written by a failed run).
+    #[arg(long, requires = "output")]
+    keep_failed: bool,
     /// Uniform desired edge length everywhere.
     #[arg(long, value_name = "H")]
     size: Option<f64>,
@@ -95,9 +111,15 @@ pub struct Args {
     /// unforced tets still below 10°).
     #[arg(long)]
     no_polish: bool,
-    /// Polish without Steiner points (no interior point is added to fix a tet below 10°).
+    /// Add no new points: recovery uses the seed's method alone (the run fails if a triangle
+    /// then cannot be recovered) and polishing adds no interior point. By default, where no fill
+    /// exists without new points, recovery adds Steiner points strictly inside the domain (never
+    /// on the surface).
     #[arg(long)]
     no_steiner: bool,
+    /// The default now (Steiner points strictly inside, where needed); kept for old scripts.
+    #[arg(long, hide = true, conflicts_with = "no_steiner")]
+    allow_interior_steiner: bool,
     /// 2D only: triangulate the PSLG's own points (isolated points included) without deploying
     /// template nodes.
     #[arg(long)]
@@ -149,6 +171,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
                 no_smooth: a.no_smooth,
                 no_deploy: a.no_deploy,
                 svg: a.svg.as_deref(),
+                keep_failed: a.keep_failed,
             },
             a.common,
         );
@@ -214,6 +237,9 @@ pub fn run(a: Args) -> Result<ExitCode> {
     if a.no_recover {
         opts.recover = None;
     }
+    if let Some(r) = opts.recover.as_mut() {
+        r.allow_interior_steiner = !a.no_steiner;
+    }
     if a.no_improve {
         opts.improve = None;
     }
@@ -245,23 +271,59 @@ pub fn run(a: Args) -> Result<ExitCode> {
     // The peak of meshing alone, before the writer builds its arrays.
     peaks.next(None);
     let peak_meshing_kb = peaks.max();
-    if let Some(out) = &a.output {
-        release_free_memory();
-        peaks.next(Some("writing"));
-        stage.set(format!("writing {}", out.display()));
-        biotet_io::write_tet_mesh(out, &mesh)?;
-    }
+    // A run that fails writes nothing at the requested paths (`--keep-failed`: the partial mesh
+    // beside the output).
+    let failed = report.recover.as_ref().is_some_and(|r| !r.is_complete());
+    let (written, failure_note) = if failed {
+        let requested: Vec<&Path> = a.output.iter().chain(&a.svg).map(|p| p.as_path()).collect();
+        let (written, note) = output::on_failure(
+            "partial mesh",
+            a.output.as_deref(),
+            &requested,
+            a.keep_failed,
+            |path| {
+                release_free_memory();
+                peaks.next(Some("writing"));
+                stage.set(format!("writing {}", path.display()));
+                biotet_io::write_tet_mesh(path, &mesh)
+            },
+        );
+        (
+            written,
+            Some(if note.is_empty() {
+                note
+            } else {
+                format!("; {note}")
+            }),
+        )
+    } else {
+        let mut sides = Vec::new();
+        if let Some(svg) = &a.svg {
+            peaks.next(Some("plotting"));
+            sides.push((svg.as_path(), plot::quality_svg(&quality, &name)?));
+        }
+        let written = output::write_all(
+            || match &a.output {
+                Some(out) => {
+                    release_free_memory();
+                    peaks.next(Some("writing"));
+                    stage.set(format!("writing {}", out.display()));
+                    biotet_io::write_tet_mesh(out, &mesh)
+                }
+                None => Ok(Vec::new()),
+            },
+            &sides,
+        )?;
+        (written, None)
+    };
     drop(stage);
-    if let Some(svg) = &a.svg {
-        peaks.next(Some("plotting"));
-        plot::write_quality_svg(&quality, svg, &name)?;
-    }
     peaks.next(None);
     let peak_kb = peaks.max();
     if a.common.json {
         crate::emit(&serde_json::to_string_pretty(&json!({
             "input": name,
             "output": a.output,
+            "written": written,
             "n_surface_triangles": surface.triangles.len(),
             "shells": shells,
             "seconds_read_validate": seconds_read,
@@ -307,6 +369,14 @@ pub fn run(a: Args) -> Result<ExitCode> {
             "input triangles missing from the mesh: {}\n",
             report.missing_triangles
         );
+        if let Some(r) = &report.recover
+            && r.steiner_points > 0
+        {
+            text += &format!(
+                "recover: {} Steiner points added strictly inside (never on the surface)\n",
+                r.steiner_points
+            );
+        }
         text += &format!(
             "min dihedral {:.3}°, max {:.3}°, tets below 10°: {}, mean q {:.3}",
             quality.min_dihedral_deg.unwrap_or(f64::NAN),
@@ -323,23 +393,26 @@ pub fn run(a: Args) -> Result<ExitCode> {
         );
         crate::emit(&text);
     }
-    if let Some(r) = &report.recover
-        && !r.is_complete()
-    {
-        if !a.common.quiet {
+    if let (Some(r), Some(note)) = (&report.recover, &failure_note) {
+        // An error: printed with --quiet too.
+        eprintln!(
+            "error: {name}: {} input triangles could not be recovered{}{note}; the first ones:",
+            r.missing_after,
+            super::recover::steiner_text(a.no_steiner)
+        );
+        for line in super::recover::unrecovered_lines(r) {
+            eprintln!("  {line}");
+        }
+        if a.no_steiner {
             eprintln!(
-                "error: {name}: {} input triangles could not be recovered without new points on \
-                 the surface (the mesh was written for inspection); the first ones:",
-                r.missing_after
-            );
-            for line in super::recover::unrecovered_lines(r) {
-                eprintln!("  {line}");
-            }
-            eprintln!(
-                "  (a size much finer than these triangles makes their cavities large: a size \
-                 closer to the surface's edges, or --size-from-surface, usually recovers them)"
+                "  (without --no-steiner, recovery adds points strictly inside the domain where \
+                 no fill exists without new points)"
             );
         }
+        eprintln!(
+            "  (a size much finer than these triangles makes their cavities large: a size \
+             closer to the surface's edges, or --size-from-surface, usually recovers them)"
+        );
         return Ok(ExitCode::from(crate::EXIT_INVALID));
     }
     Ok(ExitCode::SUCCESS)

@@ -88,6 +88,8 @@ pub struct MeshArgs<'a> {
     pub no_deploy: bool,
     /// Angle histogram SVG.
     pub svg: Option<&'a Path>,
+    /// On failure, write the partial mesh beside the output (`OUT.failed.EXT`).
+    pub keep_failed: bool,
 }
 
 /// `biotet mesh` on a PSLG.
@@ -128,16 +130,35 @@ pub fn mesh(a: MeshArgs, common: Common) -> Result<ExitCode> {
     stage.set("checking");
     let check = check_tri(&mesh, Some(&pslg));
     let quality = TriQualityReport::of(&mesh);
-    let written = match a.output {
-        Some(out) => {
-            stage.set(format!("writing {}", out.display()));
-            write(out, &mesh)?
+    // A run that fails writes nothing at the requested paths (`--keep-failed`: the partial mesh
+    // beside the output).
+    let (written, failure_note) = if check.valid {
+        let mut sides = Vec::new();
+        if let Some(svg) = a.svg {
+            sides.push((
+                svg,
+                plot::tri_quality_svg(&quality, &a.input.display().to_string())?,
+            ));
         }
-        None => Vec::new(),
+        let written = crate::output::write_all(
+            || match a.output {
+                Some(out) => {
+                    stage.set(format!("writing {}", out.display()));
+                    biotet_io::write_tri_mesh(out, &mesh)
+                }
+                None => Ok(Vec::new()),
+            },
+            &sides,
+        )?;
+        (written, None)
+    } else {
+        let requested: Vec<&Path> = a.output.iter().chain(&a.svg).copied().collect();
+        let (written, note) =
+            crate::output::on_failure("invalid mesh", a.output, &requested, a.keep_failed, |p| {
+                biotet_io::write_tri_mesh(p, &mesh)
+            });
+        (written, Some(note))
     };
-    if let Some(svg) = a.svg {
-        plot::write_tri_quality_svg(&quality, svg, &a.input.display().to_string())?;
-    }
     drop(stage);
     if common.json {
         crate::emit(&serde_json::to_string_pretty(&json!({
@@ -168,15 +189,25 @@ pub fn mesh(a: MeshArgs, common: Common) -> Result<ExitCode> {
             quality.max_angle_deg.unwrap_or(f64::NAN),
             if check.valid { "valid" } else { "INVALID" },
         ));
-        if !written.is_empty() {
+        if !written.is_empty() && failure_note.is_none() {
             crate::emit(&format!("wrote {}", files(&written)));
         }
     }
-    Ok(if check.valid {
-        ExitCode::SUCCESS
-    } else {
-        ExitCode::from(crate::EXIT_INVALID)
-    })
+    match failure_note {
+        None => Ok(ExitCode::SUCCESS),
+        Some(note) => {
+            eprintln!(
+                "error: {}: the mesh is not valid{}",
+                a.input.display(),
+                if note.is_empty() {
+                    note
+                } else {
+                    format!("; {note}")
+                }
+            );
+            Ok(ExitCode::from(crate::EXIT_INVALID))
+        }
+    }
 }
 
 /// The mesh point of each PSLG point, by exact coordinates; an error names the first missing one.
@@ -216,6 +247,7 @@ pub fn recover_cmd(
     pslg_path: &Path,
     output: Option<&Path>,
     keep_outside: bool,
+    keep_failed: bool,
     common: Common,
 ) -> Result<ExitCode> {
     let stage = Stage::start(common.quiet, format!("reading {}", mesh_path.display()));
@@ -246,9 +278,21 @@ pub fn recover_cmd(
         Some(carve(&mut mesh, &pslg).with_context(|| format!("{}", pslg_path.display()))?)
     };
     let check = check_tri(&mesh, None);
-    let written = match output {
-        Some(out) => write(out, &mesh)?,
-        None => Vec::new(),
+    // A run that fails writes nothing at the output (`--keep-failed`: the partial mesh beside it).
+    let ok = report.complete() && check.valid;
+    let (written, failure_note) = if ok {
+        let written = match output {
+            Some(out) => write(out, &mesh)?,
+            None => Vec::new(),
+        };
+        (written, None)
+    } else {
+        let requested: Vec<&Path> = output.into_iter().collect();
+        let (written, note) =
+            crate::output::on_failure("partial mesh", output, &requested, keep_failed, |p| {
+                biotet_io::write_tri_mesh(p, &mesh)
+            });
+        (written, Some(note))
     };
     drop(stage);
     if common.json {
@@ -277,15 +321,30 @@ pub fn recover_cmd(
         for f in report.failed.iter().take(10) {
             crate::emit(&format!("  {}", describe_failure(f)));
         }
-        if !written.is_empty() {
+        if !written.is_empty() && failure_note.is_none() {
             crate::emit(&format!("wrote {}", files(&written)));
         }
     }
-    Ok(if report.complete() && check.valid {
-        ExitCode::SUCCESS
-    } else {
-        ExitCode::from(crate::EXIT_INVALID)
-    })
+    match failure_note {
+        None => Ok(ExitCode::SUCCESS),
+        Some(note) => {
+            eprintln!(
+                "error: {}: {}{}",
+                mesh_path.display(),
+                if report.complete() {
+                    "the recovered mesh is not valid".to_string()
+                } else {
+                    format!("{} segments could not be recovered", report.failed.len())
+                },
+                if note.is_empty() {
+                    note
+                } else {
+                    format!("; {note}")
+                }
+            );
+            Ok(ExitCode::from(crate::EXIT_INVALID))
+        }
+    }
 }
 
 /// `biotet smooth` on a 2D mesh.
@@ -329,10 +388,16 @@ pub fn smooth_cmd(
     };
     let report = smooth_tri_with_segments(&mut mesh, &segs, &hold, &opts);
     let after = TriQualityReport::of(&mesh);
-    let written = write(output, &mesh)?;
+    let mut sides = Vec::new();
     if let Some(svg) = svg {
-        plot::write_tri_quality_svg(&after, svg, &mesh_path.display().to_string())?;
+        sides.push((
+            svg,
+            plot::tri_quality_svg(&after, &mesh_path.display().to_string())?,
+        ));
     }
+    let mut written =
+        crate::output::write_all(|| biotet_io::write_tri_mesh(output, &mesh), &sides)?;
+    written.truncate(written.len() - sides.len());
     drop(stage);
     if common.json {
         crate::emit(&serde_json::to_string_pretty(&json!({

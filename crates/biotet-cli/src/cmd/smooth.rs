@@ -1,7 +1,7 @@
 //! `biotet smooth`: raise the smallest solid angles of a tet mesh by moving nodes (dissertation
 //! chapter 4); connectivity and node order are kept.
 
-use crate::{Common, plot, progress::Stage};
+use crate::{Common, output, plot, progress::Stage};
 use anyhow::{Context, Result};
 use biotet::quality::QualityReport;
 use biotet::smooth::{Boundary, SmoothOptions, smooth, solid_angle_share_below};
@@ -91,23 +91,25 @@ pub fn run(a: Args) -> Result<ExitCode> {
     stage.set("measuring");
     let after = QualityReport::of(&mesh);
     let share_after = solid_angle_share_below(&mesh, 0.2);
-    stage.set(format!("writing {}", a.output.display()));
-    biotet_io::write_tet_mesh(&a.output, &mesh)?;
-    drop(stage);
+    let mut sides = Vec::new();
     if let Some(svg) = &a.svg {
         let title = a
             .mesh
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_default();
-        plot::write_smooth_svg(
+        let text = plot::smooth_svg(
             &before,
             &after,
             (share_before, share_after),
-            svg,
             &format!("{title}: smoothed ({:?} boundary)", opts.boundary).to_lowercase(),
         )?;
+        sides.push((svg.as_path(), text));
     }
+    stage.set(format!("writing {}", a.output.display()));
+    // The SVG only with the mesh: an error writing either leaves both unwritten.
+    output::write_all(|| biotet_io::write_tet_mesh(&a.output, &mesh), &sides)?;
+    drop(stage);
     if a.common.json {
         crate::emit(&serde_json::to_string_pretty(&json!({
             "input": a.mesh,
