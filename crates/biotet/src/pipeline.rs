@@ -152,7 +152,7 @@ pub fn mesh_surface<S: Borrow<Sizing>>(
 
     progress("deploying nodes");
     let clock = Instant::now();
-    let dep = deploy(surface, sizing.borrow(), &opts.deploy)?;
+    let mut dep = deploy(surface, sizing.borrow(), &opts.deploy)?;
     drop(sizing);
     report.template = dep.stats.clone();
     report.n_surface_points = dep.n_surface;
@@ -161,6 +161,13 @@ pub fn mesh_surface<S: Borrow<Sizing>>(
 
     progress("tetrahedralizing");
     let clock = Instant::now();
+    if opts.recover.is_some() {
+        // Eight corners of a box around everything, outside (region 0): no surface triangle
+        // then lies on the convex hull, where a planar facet split otherwise than the hull's
+        // faces has no cavity to be recovered in. Only outside tets use them; they go with
+        // those after recovery.
+        enclose(&mut dep.points, &mut dep.interior_regions);
+    }
     // The triangulation takes the points (no second copy); they come back by vertex number,
     // which is the input order for distinct points.
     let n_points = dep.points.len();
@@ -415,4 +422,36 @@ pub fn missing_triangles(mesh: &TetMesh, surface: &SurfaceMesh) -> usize {
             !faces.contains(&k)
         })
         .count()
+}
+
+/// Append the corners of a box a quarter of the extent larger than the points' bounding box on
+/// every side, labelled 0 (outside).
+fn enclose(points: &mut Vec<[f64; 3]>, regions: &mut Vec<u32>) {
+    if points.is_empty() {
+        return;
+    }
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in points.iter() {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let extent = (0..3)
+        .map(|k| hi[k] - lo[k])
+        .fold(0.0, f64::max)
+        .max(1e-300);
+    let margin = 0.25 * extent;
+    for i in 0..8 {
+        let pick = |k: usize| {
+            if i >> k & 1 == 0 {
+                lo[k] - margin
+            } else {
+                hi[k] + margin
+            }
+        };
+        points.push([pick(0), pick(1), pick(2)]);
+        regions.push(0);
+    }
 }

@@ -12,6 +12,7 @@
 
 pub(crate) mod cells;
 pub mod improve;
+pub(crate) mod kernel;
 pub mod recover;
 pub mod search;
 

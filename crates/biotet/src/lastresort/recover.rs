@@ -61,6 +61,7 @@
 //! whose search exhausts its node budget costs up to a few hundred ms.
 
 use super::cells::Cells;
+use super::kernel::{cone, kernel_point, split_insert};
 use super::search::{SearchError, SearchOptions, Searcher, bbox, boxes_apart};
 use crate::delaunay::Delaunay;
 // The filtered orient3d: the exact predicate's answer, faster.
@@ -94,6 +95,10 @@ pub struct RecoverOptions {
     pub max_cavity_tets: usize,
     /// As a last resort, add one point strictly inside a failed cavity and search again.
     pub allow_interior_steiner: bool,
+    /// A triangle whose cavities failed this many times (each time the whole growth) is not
+    /// queued again: it goes to the Steiner fallback, or is reported. Bounds the work where
+    /// many triangles fail, which otherwise retries each after every success.
+    pub max_tries: u32,
     /// Remove the tets of region 0 (outside the surface) at the end.
     pub remove_outside: bool,
     /// Each cell is first searched with this quality threshold ηe (fewer candidates, better
@@ -105,6 +110,15 @@ pub struct RecoverOptions {
 /// cavity of the corners, whose search is better conditioned).
 const CROSSED_MAX_TETS: usize = 64;
 
+/// Largest cavity of the Steiner fallback (see [`RecoverOptions::max_cavity_tets`]).
+const STEINER_MAX_TETS: usize = 300;
+
+/// Rounds of the Steiner fallback, each followed by the no-new-point queue.
+const STEINER_ROUNDS: usize = 8;
+
+/// Growth rings of the Steiner fallback's cavities (see [`RecoverOptions::max_grow`]).
+const STEINER_GROW: u32 = 2;
+
 /// Node budget of the first, higher-threshold try.
 const FIRST_TRY_NODES: u64 = 500;
 
@@ -112,12 +126,13 @@ impl Default for RecoverOptions {
     fn default() -> Self {
         RecoverOptions {
             search: SearchOptions {
-                max_nodes: 2_000,
+                max_nodes: 400,
                 ..SearchOptions::default()
             },
-            max_grow: 6,
-            max_cavity_tets: 1500,
-            allow_interior_steiner: false,
+            max_grow: 2,
+            max_cavity_tets: 300,
+            allow_interior_steiner: true,
+            max_tries: 1,
             remove_outside: true,
             first_quality: 0.05,
         }
@@ -206,6 +221,9 @@ pub struct RecoverReport {
     /// Steiner points added strictly inside the domain (never on the surface) where no fill of a
     /// cavity with the existing points was found (only with `allow_interior_steiner`).
     pub steiner_points: usize,
+    /// Surface points the input mesh lacked (or held in no tet), put back by splitting the
+    /// tets that hold them before any triangle is recovered.
+    pub surface_points_reinserted: usize,
     /// Tets of region 0 removed at the end.
     pub outside_tets_removed: usize,
     /// Regions whose surrounding surface triangles disagree about their label (left as they
@@ -263,30 +281,46 @@ fn recover_checked(
     for (i, p) in mesh.points.iter().enumerate() {
         at.entry(coord_key(p)).or_insert(i as u32);
     }
-    let tri_map: Vec<Option<[u32; 3]>> = surface
-        .triangles
-        .iter()
-        .map(|t| {
-            let v = t.map(|i| at.get(&coord_key(&surface.points[i as usize])).copied());
-            match v {
-                [Some(a), Some(b), Some(c)] => Some([a, b, c]),
-                _ => None,
-            }
-        })
-        .collect();
+    let tri_map = map_triangles(surface, &at);
     drop(at);
 
     let mut r = Recovery::new(mesh, surface, tri_map, *opts);
     r.scan_present();
     let missing_before = r.count_missing();
     let domain = r.cover()?;
-    if domain != Domain::Convex {
+    // Surface points the mesh lacks (or holds in no tet: a mesh whose outside tets were
+    // removed drops them) are the surface's own points, not new ones: put them back first.
+    let absent = r.absent_surface_points();
+    let (mut r, reinserted) = if absent.is_empty() {
+        (r, 0)
+    } else {
+        drop(r);
+        let n = insert_points(mesh, &absent)?;
+        let mut at: FxHashMap<[u64; 3], u32> = FxHashMap::default();
+        for (i, p) in mesh.points.iter().enumerate() {
+            at.entry(coord_key(p)).or_insert(i as u32);
+        }
+        let tri_map = map_triangles(surface, &at);
+        (Recovery::new(mesh, surface, tri_map, *opts), n)
+    };
+    if domain != Domain::Convex || reinserted > 0 {
         // Tets put back may hold surface triangles.
         r.scan_present();
     }
     r.run();
     if opts.allow_interior_steiner {
-        r.run_steiner();
+        // A Steiner fill changes the cavities of the triangles around it: alternate the
+        // fallback with the no-new-point queue while either makes progress.
+        for _ in 0..STEINER_ROUNDS {
+            let before = r.count_missing();
+            r.run_steiner();
+            r.tries.clear();
+            r.run();
+            let after = r.count_missing();
+            if after == 0 || after == before {
+                break;
+            }
+        }
     }
     r.compact();
     // Also sets the final `is_present`.
@@ -336,12 +370,116 @@ fn recover_checked(
         nodes_total: nodes.iter().sum(),
         cavity_tets_median: sizes.get(sizes.len() / 2).copied().unwrap_or(0),
         steiner_points: r.steiner_points,
+        surface_points_reinserted: reinserted,
         outside_tets_removed: removed,
         label_conflicts: conflicts,
         total_ms: t0.elapsed().as_secs_f64() * 1e3,
         unrecovered,
     };
     Ok(report)
+}
+
+/// Surface triangles in mesh point numbers, by exact coordinates (`None`: a corner is no mesh
+/// point).
+fn map_triangles(surface: &SurfaceMesh, at: &FxHashMap<[u64; 3], u32>) -> Vec<Option<[u32; 3]>> {
+    surface
+        .triangles
+        .iter()
+        .map(|t| {
+            let v = t.map(|i| at.get(&coord_key(&surface.points[i as usize])).copied());
+            match v {
+                [Some(a), Some(b), Some(c)] => Some([a, b, c]),
+                _ => None,
+            }
+        })
+        .collect()
+}
+
+/// Put each point of `pts` into `mesh` (appended unless a mesh point has its coordinates) by
+/// splitting every tet whose closure holds it (exact, [`split_insert`]); the adjacency is
+/// rebuilt once at the end. Returns how many were put in; a point outside every tet is an
+/// error (the mesh does not cover the surface).
+fn insert_points(mesh: &mut TetMesh, pts: &[P3]) -> Result<usize, RecoverError> {
+    let mut at: FxHashMap<[u64; 3], u32> = FxHashMap::default();
+    for (i, p) in mesh.points.iter().enumerate() {
+        at.entry(coord_key(p)).or_insert(i as u32);
+    }
+    let mut holding = Vec::new();
+    let mut local = Vec::new();
+    for &p in pts {
+        let id = *at.entry(coord_key(&p)).or_insert_with(|| {
+            mesh.points.push(p);
+            (mesh.points.len() - 1) as u32
+        });
+        holding.clear();
+        for (t, v) in mesh.tets.iter().enumerate() {
+            let c = v.map(|x| mesh.points[x as usize]);
+            if v.contains(&id)
+                || (0..3).any(|k| c.iter().all(|q| q[k] < p[k]) || c.iter().all(|q| q[k] > p[k]))
+            {
+                continue;
+            }
+            if TET_FACES
+                .iter()
+                .all(|f| orient3d(c[f[0]], c[f[1]], c[f[2]], p) != Sign::Positive)
+            {
+                holding.push(t);
+            }
+        }
+        if holding.is_empty() {
+            // Outside the (convex) mesh: the cone from it over the boundary faces it sees
+            // strictly is the convex hull grown by it (outside tets, label 0).
+            if !extend_hull(mesh, id) {
+                return Err(RecoverError::NotCovering(format!(
+                    "surface point {p:?} lies outside the mesh"
+                )));
+            }
+            continue;
+        }
+        local.clear();
+        local.extend(holding.iter().map(|&t| mesh.tets[t]));
+        if !split_insert(&mesh.points, &mut local, id) {
+            return Err(RecoverError::NotCovering(format!(
+                "surface point {p:?} lies outside the mesh"
+            )));
+        }
+        let label = mesh.labels[holding[0]];
+        for (k, t) in local.drain(..).enumerate() {
+            if let Some(&slot) = holding.get(k) {
+                mesh.tets[slot] = t;
+            } else {
+                mesh.tets.push(t);
+                mesh.labels.push(label);
+            }
+        }
+    }
+    mesh.rebuild_neighbors();
+    Ok(pts.len())
+}
+
+/// Add the tets from point `x` to every mesh boundary face that sees it strictly from outside
+/// (exact); the adjacency is rebuilt. False when no face sees it.
+fn extend_hull(mesh: &mut TetMesh, x: u32) -> bool {
+    mesh.rebuild_neighbors();
+    let p = mesh.points[x as usize];
+    let mut added = Vec::new();
+    for t in 0..mesh.tets.len() {
+        for f in 0..4 {
+            if mesh.neighbors[t][f] == NO_NEIGHBOR {
+                let g = mesh.face(t, f);
+                let c = g.map(|v| mesh.points[v as usize]);
+                if orient3d(c[0], c[1], c[2], p) == Sign::Positive {
+                    added.push([g[0], g[1], g[2], x]);
+                }
+            }
+        }
+    }
+    let any = !added.is_empty();
+    for t in added {
+        mesh.tets.push(t);
+        mesh.labels.push(0);
+    }
+    any
 }
 
 /// Check the inputs; `full`: also every tet's orientation (exact) and the adjacency (rebuilt).
@@ -448,6 +586,8 @@ struct Recovery<'a> {
     crossed_ok: usize,
     grown: usize,
     steiner_points: usize,
+    /// Failed serial attempts per triangle.
+    tries: FxHashMap<u32, u8>,
 }
 
 /// Stamped marks and buffers of the read-only stages (walks, carving, searches): one for the
@@ -568,6 +708,20 @@ struct Speculative {
     calls: Vec<(f64, u64, usize)>,
 }
 
+/// A cavity point made by the kernel fallback, not yet a mesh point (see [`pending_id`]).
+const PENDING: u32 = u32::MAX;
+
+/// The id a new tet holds for the pending point of local index `x` until it is numbered (mesh
+/// ids stay below 2³¹, see `validate_inputs`).
+fn pending_id(x: u32) -> u32 {
+    u32::MAX - 1 - x
+}
+
+/// The local index behind a [`pending_id`].
+fn pending_local(id: u32) -> u32 {
+    u32::MAX - 1 - id
+}
+
 /// Missing triangles tried at once on one view; fixed, so the result does not depend on the
 /// number of threads.
 const BATCH: usize = 64;
@@ -602,8 +756,9 @@ enum Failure {
     /// The missing triangle is not inside the cavity (crosses its shell).
     NotInside,
     TooLarge,
-    NoSteiner,
     Cells,
+    /// A cell with no fill of its points has no point strictly inside its kernel.
+    NoKernel,
     Search(SearchError),
 }
 
@@ -612,8 +767,10 @@ impl Failure {
         match self {
             Failure::NotInside => "the triangle leaves the largest cavity tried".into(),
             Failure::TooLarge => "the cavity grew too large".into(),
-            Failure::NoSteiner => "no interior point could be placed in the cavity".into(),
             Failure::Cells => "the cavity's constrained faces do not split it into cells".into(),
+            Failure::NoKernel => "no fill exists without new points, and no cell of the cavity \
+                                  is star-shaped for one interior point"
+                .into(),
             Failure::Search(SearchError::NoFill { .. }) => {
                 "no fill of the cavity exists without new points (search exhausted)".into()
             }
@@ -1017,16 +1174,21 @@ impl View<'_> {
     }
 
     /// Split into cells and search each; the new tets in global numbering.
+    /// With `kernel`, a cell that has no fill of its own points gets one new point strictly
+    /// inside its kernel (see [`kernel_point`]): a fill through it is searched, else the cone
+    /// from it is taken. Such points enter `cav.points` as [`PENDING`], for the caller to
+    /// number.
     fn fill_cells(
         &self,
         w: &mut Work,
         cav: &mut Cavity,
         nodes: &mut u64,
+        kernel: bool,
     ) -> Result<Vec<[u32; 4]>, Failure> {
         let mut cell = std::mem::take(&mut w.cell);
         let mut faces = std::mem::take(&mut w.faces);
         let mut inner = std::mem::take(&mut w.inner);
-        let r = self.fill_cells_with(w, cav, nodes, &mut cell, &mut faces, &mut inner);
+        let r = self.fill_cells_with(w, cav, nodes, kernel, &mut cell, &mut faces, &mut inner);
         w.cell = cell;
         w.faces = faces;
         w.inner = inner;
@@ -1034,11 +1196,14 @@ impl View<'_> {
     }
 
     /// [`Self::fill_cells`] with its buffers.
+    // The three buffers are the scratch's, taken out for the call.
+    #[allow(clippy::too_many_arguments)]
     fn fill_cells_with(
         &self,
         w: &mut Work,
         cav: &mut Cavity,
         nodes: &mut u64,
+        kernel: bool,
         cell: &mut Vec<u32>,
         faces: &mut Vec<[u32; 3]>,
         inner: &mut Vec<u32>,
@@ -1095,7 +1260,42 @@ impl View<'_> {
                 }
                 Err(e) => {
                     *nodes += nodes_of(&e);
-                    return Err(Failure::Search(e));
+                    if !kernel {
+                        return Err(Failure::Search(e));
+                    }
+                    let p = kernel_point(&cav.coords, faces).ok_or(Failure::NoKernel)?;
+                    let k = cav.points.len() as u32;
+                    cav.points.push(PENDING);
+                    cav.coords.push(p);
+                    // A fill through the new point (better tets than the cone, usually).
+                    let o = SearchOptions {
+                        max_nodes: self.opts.search.max_nodes.min(FIRST_TRY_NODES),
+                        ..self.opts.search
+                    };
+                    inner.push(k);
+                    let found = w.searcher.fill(&cav.coords, faces, inner, &o);
+                    inner.pop();
+                    let tets = match found {
+                        Ok(f) => {
+                            *nodes += f.nodes_visited;
+                            f.tets
+                        }
+                        Err(e) => {
+                            *nodes += nodes_of(&e);
+                            // The cone, with the isolated points inside the cell split in.
+                            let mut tets: Vec<[u32; 4]> = cone(faces, k).collect();
+                            for &x in inner.iter() {
+                                split_insert(&cav.coords, &mut tets, x);
+                            }
+                            tets
+                        }
+                    };
+                    out.extend(tets.iter().map(|t| {
+                        t.map(|x| {
+                            let g = cav.points[x as usize];
+                            if g == PENDING { pending_id(x) } else { g }
+                        })
+                    }));
                 }
             }
         }
@@ -1116,7 +1316,7 @@ impl View<'_> {
         let mut cav = Cavity::default();
         let r = self
             .carve(w, m, tets, &mut cav)
-            .and_then(|()| self.fill_cells(w, &mut cav, &mut nodes));
+            .and_then(|()| self.fill_cells(w, &mut cav, &mut nodes, false));
         calls.push((start.elapsed().as_secs_f64() * 1e3, nodes, cav.tets.len()));
         r.map(|t| (cav, t))
     }
@@ -1219,6 +1419,7 @@ impl<'a> Recovery<'a> {
             crossed_ok: 0,
             grown: 0,
             steiner_points: 0,
+            tries: FxHashMap::default(),
         };
         r.index();
         r
@@ -1455,8 +1656,14 @@ impl<'a> Recovery<'a> {
                             stalled = 0;
                             self.reason.remove(&s);
                         } else {
-                            stalled += 1;
-                            queue.push_back(s);
+                            // Bounded by work: a triangle failed this often is left to the
+                            // Steiner fallback (or reported), not retried after every success.
+                            let n = self.tries.entry(s).or_insert(0);
+                            *n += 1;
+                            if u32::from(*n) < self.opts.max_tries {
+                                stalled += 1;
+                                queue.push_back(s);
+                            }
                         }
                     }
                 }
@@ -1482,11 +1689,12 @@ impl<'a> Recovery<'a> {
     /// One triangle: first the smallest cavity (the tets it crosses), then the cavity of its
     /// corners, grown on failure.
     fn attempt(&mut self, s: u32, v: [u32; 3], steiner: Option<()>) -> bool {
-        if steiner.is_none()
-            && let Some(crossed) = self.with_work(|view, w| view.crossed_tets(w, v))
-        {
+        // With Steiner points, the small cavities first too: a cell of few faces is more
+        // likely star-shaped, and its cone is small.
+        let kernel = steiner.is_some();
+        if let Some(crossed) = self.with_work(|view, w| view.crossed_tets(w, v)) {
             self.crossed_tried += 1;
-            if self.carve_and_fill(v, &crossed, false).is_ok() {
+            if self.carve_and_fill(v, &crossed, kernel).is_ok() {
                 self.crossed_ok += 1;
                 return true;
             }
@@ -1494,7 +1702,7 @@ impl<'a> Recovery<'a> {
             // and on brain_20k it recovers all but 2 of the triangles the crossed tets miss.
             let mut ring = crossed;
             self.with_work(|view, w| view.grow(w, &mut ring));
-            if self.carve_and_fill(v, &ring, false).is_ok() {
+            if self.carve_and_fill(v, &ring, kernel).is_ok() {
                 self.crossed_ok += 1;
                 return true;
             }
@@ -1513,12 +1721,24 @@ impl<'a> Recovery<'a> {
             }
             tets
         });
-        for ring in 0..=self.opts.max_grow {
+        // The fallback may need a wider cavity to find a star-shaped cell; it runs once per
+        // triangle, so it gets more rings than the no-new-point search.
+        let rings = if kernel {
+            self.opts.max_grow.max(STEINER_GROW)
+        } else {
+            self.opts.max_grow
+        };
+        for ring in 0..=rings {
             if ring > 0 {
                 self.grown += 1;
                 self.with_work(|view, w| view.grow(w, &mut tets));
             }
-            if tets.len() > self.opts.max_cavity_tets {
+            let cap = if kernel {
+                self.opts.max_cavity_tets.max(STEINER_MAX_TETS)
+            } else {
+                self.opts.max_cavity_tets
+            };
+            if tets.len() > cap {
                 self.reason.insert(s, Failure::TooLarge.describe());
                 break;
             }
@@ -1538,12 +1758,12 @@ impl<'a> Recovery<'a> {
         let mut nodes = 0u64;
         let n0 = self.mesh.points.len();
         let mut cav = Cavity::default();
-        let mut result = self.with_work(|view, w| view.carve(w, m, tets, &mut cav));
-        if steiner && result.is_ok() {
-            result = self.add_steiner(&mut cav);
-        }
-        let result = result
-            .and_then(|()| self.with_work(|view, w| view.fill_cells(w, &mut cav, &mut nodes)));
+        let result = self
+            .with_work(|view, w| view.carve(w, m, tets, &mut cav))
+            .and_then(|()| {
+                self.with_work(|view, w| view.fill_cells(w, &mut cav, &mut nodes, steiner))
+            })
+            .and_then(|new_tets| self.number_pending(&mut cav, new_tets));
         let ok = match result {
             Ok(new_tets) => {
                 self.insert(&cav, &new_tets);
@@ -1657,38 +1877,42 @@ impl<'a> Recovery<'a> {
         }
     }
 
-    /// Put one point strictly inside the cavity: the average of the cavity's points, when it
-    /// lies strictly inside a carved tet and on no surface triangle (exact tests).
-    fn add_steiner(&mut self, cav: &mut Cavity) -> Result<(), Failure> {
-        let n = cav.coords.len().max(1) as f64;
-        let mut p = [0.0; 3];
-        for c in &cav.coords {
-            for k in 0..3 {
-                p[k] += c[k] / n;
+    /// Give the kernel points of a fill (see [`View::fill_cells`]) mesh numbers, in local
+    /// order, and put them in its tets; refused when one lies on a surface triangle (exact).
+    fn number_pending(
+        &mut self,
+        cav: &mut Cavity,
+        mut new_tets: Vec<[u32; 4]>,
+    ) -> Result<Vec<[u32; 4]>, Failure> {
+        let pending: Vec<usize> = (0..cav.points.len())
+            .filter(|&x| cav.points[x] == PENDING)
+            .collect();
+        if pending.is_empty() {
+            return Ok(new_tets);
+        }
+        if pending.iter().any(|&x| self.on_surface(cav.coords[x])) {
+            return Err(Failure::NoKernel);
+        }
+        for x in pending {
+            let id = self.mesh.points.len() as u32;
+            self.mesh.points.push(cav.coords[x]);
+            self.vtet.push(NO_NEIGHBOR);
+            self.surf_start.push(self.surf_list.len() as u32);
+            let w = &mut self.work;
+            w.pt_mark.push(0);
+            w.side_mark.push(0);
+            w.side.push(Sign::Zero);
+            w.pt_local.push(x as u32);
+            cav.points[x] = id;
+        }
+        for t in &mut new_tets {
+            for v in t.iter_mut() {
+                if *v >= 1 << 31 {
+                    *v = cav.points[pending_local(*v) as usize];
+                }
             }
         }
-        let strictly = cav.tets.iter().any(|&t| {
-            let c = self.mesh.corners(t as usize);
-            TET_FACES
-                .iter()
-                .all(|f| orient3d(c[f[0]], c[f[1]], c[f[2]], p) == Sign::Negative)
-        });
-        if !strictly || !p.iter().all(|&x| in_exact_range(x)) || self.on_surface(p) {
-            return Err(Failure::NoSteiner);
-        }
-        let id = self.mesh.points.len() as u32;
-        // A cavity point now; removed again by `carve_and_fill` if the fill fails.
-        self.mesh.points.push(p);
-        self.vtet.push(NO_NEIGHBOR);
-        self.surf_start.push(self.surf_list.len() as u32);
-        let w = &mut self.work;
-        w.pt_mark.push(w.stamp);
-        w.side_mark.push(0);
-        w.side.push(Sign::Zero);
-        w.pt_local.push(cav.points.len() as u32);
-        cav.points.push(id);
-        cav.coords.push(p);
-        Ok(())
+        Ok(new_tets)
     }
 
     /// Whether `p` lies on a surface triangle (exact).
@@ -1700,6 +1924,40 @@ impl<'a> Recovery<'a> {
             }
             crate::geom::intersect::seg_tri(p, p, &c).meets()
         })
+    }
+
+    /// Coordinates of the surface points (once each) that are no mesh point or a mesh point in
+    /// no live tet.
+    fn absent_surface_points(&self) -> Vec<P3> {
+        let mut seen: FxHashSet<[u64; 3]> = FxHashSet::default();
+        let mut out = Vec::new();
+        for (s, m) in self.tri_map.iter().enumerate() {
+            let corners = self.surface.triangles[s];
+            for (k, &c) in corners.iter().enumerate() {
+                let lacks = match m {
+                    Some(v) => self.vtet[v[k] as usize] == NO_NEIGHBOR,
+                    None => true,
+                };
+                let p = self.surface.points[c as usize];
+                if lacks && seen.insert(coord_key(&p)) {
+                    // Mapped corners of a partly mapped triangle are checked by `vtet`.
+                    if m.is_none() && self.has_live_point(p) {
+                        continue;
+                    }
+                    out.push(p);
+                }
+            }
+        }
+        out
+    }
+
+    /// Whether a mesh point in a live tet has the coordinates `p`.
+    fn has_live_point(&self, p: P3) -> bool {
+        self.mesh
+            .points
+            .iter()
+            .enumerate()
+            .any(|(i, q)| *q == p && self.vtet[i] != NO_NEIGHBOR)
     }
 
     /// Last resort: the failed triangles again, each cavity with one interior point.

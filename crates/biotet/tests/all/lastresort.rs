@@ -583,7 +583,11 @@ fn recover_fails_honestly_on_schoenhardt() {
     let (p, f) = twisted_prism(30.0, false);
     let s = surface_of(&p, &f);
     let mut m = Delaunay::new(&p).unwrap().to_tet_mesh();
-    let r = recover(&mut m, &s, &RecoverOptions::default()).unwrap();
+    let no = RecoverOptions {
+        allow_interior_steiner: false,
+        ..RecoverOptions::default()
+    };
+    let r = recover(&mut m, &s, &no).unwrap();
     assert!(!r.is_complete());
     assert_eq!(r.missing_after, r.unrecovered.len());
     assert!(r.missing_before >= 3);
@@ -594,13 +598,9 @@ fn recover_fails_honestly_on_schoenhardt() {
     }
     assert_eq!(r.steiner_points, 0);
     assert_eq!(m.points.len(), 6);
-    // With one interior point allowed, it is recovered.
+    // With the fallback (the default), one interior point recovers it.
     let mut m = Delaunay::new(&p).unwrap().to_tet_mesh();
-    let opts = RecoverOptions {
-        allow_interior_steiner: true,
-        ..RecoverOptions::default()
-    };
-    let r = recover(&mut m, &s, &opts).unwrap();
+    let r = recover(&mut m, &s, &RecoverOptions::default()).unwrap();
     assert!(r.is_complete(), "{r:?}");
     assert_eq!(r.steiner_points, 1);
     assert_eq!(m.points.len(), 7);
@@ -692,4 +692,114 @@ fn recover_is_the_same_on_any_number_of_threads() {
     assert!(r1.missing_before > 0 && r1.is_complete(), "{r1:?}");
     let c = check(&one, Some(&s));
     assert!(c.valid, "{c}");
+}
+
+#[test]
+fn recover_puts_back_surface_points_the_mesh_dropped() {
+    // A mesher that removes the outside tets and then the points no tet uses leaves surface
+    // points out: recover puts them back (they are the surface's own points) before it
+    // recovers the triangles.
+    let s = crate::common::load_stl("brain_20k.stl");
+    let mut m = delaunay_trimmed(&s);
+    // Also the tets at every 97th point, as a mesher that lost them would.
+    let keep: Vec<bool> = m
+        .tets
+        .iter()
+        .map(|t| t.iter().all(|x| x % 97 != 0))
+        .collect();
+    let mut k = 0;
+    for t in 0..keep.len() {
+        if keep[t] {
+            m.tets[k] = m.tets[t];
+            k += 1;
+        }
+    }
+    m.tets.truncate(k);
+    m.labels.truncate(k);
+    let mut used = vec![false; m.points.len()];
+    for t in &m.tets {
+        for &x in t {
+            used[x as usize] = true;
+        }
+    }
+    let mut new_id = vec![u32::MAX; m.points.len()];
+    let mut points = Vec::new();
+    for (i, p) in m.points.iter().enumerate() {
+        if used[i] {
+            new_id[i] = points.len() as u32;
+            points.push(*p);
+        }
+    }
+    let dropped = m.points.len() - points.len();
+    assert!(dropped > 0, "the trimmed mesh uses every point");
+    m.points = points;
+    for t in &mut m.tets {
+        *t = t.map(|x| new_id[x as usize]);
+    }
+    m.rebuild_neighbors();
+    let r = recover(&mut m, &s, &RecoverOptions::default()).unwrap();
+    assert_eq!(r.surface_points_reinserted, dropped, "{r:?}");
+    assert!(r.is_complete(), "{} unrecovered", r.missing_after);
+    let c = check(&m, Some(&s));
+    assert!(c.valid, "{c}");
+    let (v, v0) = (mesh_volume(&m), enclosed_volume(&s));
+    assert!((v - v0).abs() < 1e-9 * v0, "volume {v} vs {v0}");
+}
+
+/// trimesh's `creation.box` face list: its face diagonals admit no tetrahedralization of the
+/// eight corners, so one interior point is needed.
+fn twisted_cube() -> SurfaceMesh {
+    let p: Vec<P3> = (0..8)
+        .map(|i| {
+            [
+                (i >> 2 & 1) as f64 - 0.5,
+                (i >> 1 & 1) as f64 - 0.5,
+                (i & 1) as f64 - 0.5,
+            ]
+        })
+        .collect();
+    let tris = vec![
+        [1, 3, 0],
+        [4, 1, 0],
+        [0, 3, 2],
+        [2, 4, 0],
+        [1, 7, 3],
+        [5, 1, 4],
+        [5, 7, 1],
+        [3, 7, 2],
+        [6, 4, 2],
+        [2, 7, 6],
+        [6, 5, 4],
+        [7, 5, 6],
+    ];
+    SurfaceMesh::closed(p, tris, 1)
+}
+
+#[test]
+fn a_cube_whose_diagonals_twist_gets_one_interior_point() {
+    let s = twisted_cube();
+    assert!(biotet::mesh::validate::validate_surface(&mut s.clone(), &Default::default()).is_ok());
+    let p = s.points.clone();
+    // Without new points the seed's method cannot finish ...
+    let mut m = Delaunay::new(&p).unwrap().to_tet_mesh();
+    let no = RecoverOptions {
+        allow_interior_steiner: false,
+        ..RecoverOptions::default()
+    };
+    let r = recover(&mut m, &s, &no).unwrap();
+    assert!(!r.is_complete());
+    // ... with the fallback (the default) one point strictly inside, never on the surface.
+    let mut m = Delaunay::new(&p).unwrap().to_tet_mesh();
+    let r = recover(&mut m, &s, &RecoverOptions::default()).unwrap();
+    assert!(r.is_complete(), "{r:?}");
+    assert_eq!(r.steiner_points, 1);
+    assert_eq!(m.points.len(), 9);
+    let q = m.points[8];
+    assert!(
+        q.iter().all(|&c| c > -0.5 && c < 0.5),
+        "{q:?} not strictly inside"
+    );
+    let c = check(&m, Some(&s));
+    assert!(c.valid, "{c}");
+    assert!((mesh_volume(&m) - 1.0).abs() < 1e-12);
 }

@@ -1,0 +1,94 @@
+//! Issue 19's test set: shapes nobody tuned for (`tests/data/shapes`, made by
+//! `scripts/make_shapes.py`: gmsh/OpenCASCADE CAD solids, trimesh primitives, meshes shipped in
+//! package wheels, generated degenerate cases). Every valid one must mesh with the defaults,
+//! keep every input triangle and pass `biotet check --surface`; the files named `invalid_*` are
+//! refused by `validate`, and `mesh` then writes nothing.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn shapes() -> Vec<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/shapes");
+    let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .expect("tests/data/shapes")
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "off"))
+        .collect();
+    v.sort();
+    v
+}
+
+fn biotet(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_biotet"))
+        .args(args)
+        .output()
+        .expect("run biotet")
+}
+
+fn is_invalid(p: &Path) -> bool {
+    p.file_name()
+        .unwrap()
+        .to_string_lossy()
+        .starts_with("invalid_")
+}
+
+#[test]
+fn every_valid_shape_meshes_with_every_triangle_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut failures = Vec::new();
+    let mut meshed = 0;
+    for s in shapes().iter().filter(|p| !is_invalid(p)) {
+        let name = s.file_stem().unwrap().to_string_lossy().to_string();
+        let out = dir.path().join(format!("{name}.vtu"));
+        let (s_str, out_str) = (s.to_str().unwrap(), out.to_str().unwrap());
+        let v = biotet(&["validate", s_str, "-q"]);
+        assert!(v.status.success(), "{name}: validate refuses it");
+        let m = biotet(&["mesh", s_str, "-o", out_str, "--json", "--threads", "1"]);
+        if !m.status.success() {
+            failures.push(format!(
+                "{name}: mesh exit {:?}: {}",
+                m.status.code(),
+                String::from_utf8_lossy(&m.stderr)
+                    .lines()
+                    .next()
+                    .unwrap_or("")
+            ));
+            assert!(!out.exists(), "{name}: a failed run wrote its output");
+            continue;
+        }
+        let j: serde_json::Value = serde_json::from_slice(&m.stdout).unwrap();
+        let p = &j["pipeline"];
+        assert_eq!(p["missing_triangles"], 0, "{name}");
+        let steiner = p["recover"]["steiner_points"].as_u64().unwrap();
+        assert!(p["n_tets"].as_u64().unwrap() > 0, "{name}");
+        let c = biotet(&["check", out_str, "--surface", s_str, "--json"]);
+        let cj: serde_json::Value = serde_json::from_slice(&c.stdout).unwrap();
+        assert!(
+            c.status.success(),
+            "{name}: check fails: {}",
+            String::from_utf8_lossy(&c.stdout)
+        );
+        assert_eq!(cj["valid"], true, "{name}");
+        // Steiner points are interior: the output's points are the surface's, the interior
+        // nodes and those (the check above finds every triangle with its own corners).
+        assert!(steiner < 1000, "{name}: {steiner} Steiner points");
+        meshed += 1;
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    assert!(meshed >= 40, "only {meshed} shapes");
+}
+
+#[test]
+fn invalid_shapes_are_refused_by_validate_naming_the_element() {
+    let bad: Vec<PathBuf> = shapes().into_iter().filter(|p| is_invalid(p)).collect();
+    assert!(!bad.is_empty());
+    for s in bad {
+        let v = biotet(&["validate", s.to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&v.stderr);
+        assert!(
+            !v.status.success() || err.contains("touch") || err.contains("shared"),
+            "{}: {err}",
+            s.display()
+        );
+    }
+}

@@ -1,0 +1,164 @@
+//! A point strictly inside the kernel of a closed cell: the fallback of boundary recovery when
+//! no fill of a cell with its own points exists (a Schönhardt polyhedron, a cube whose face
+//! diagonals twist).
+//!
+//! A cell is a closed polyhedron given by oriented triangles whose right-hand normals point
+//! into it. Its kernel is the set of points that see every face from inside, the intersection
+//! of the faces' inner half-spaces. From a point strictly inside the kernel, the cone over the
+//! faces (one tet per face) is a valid fill: every tet is positively oriented, and since every
+//! ray from the point leaves the cell exactly once, the tets do not overlap.
+//!
+//! The point is searched in floating point (maximise the smallest distance to the face planes,
+//! the Chebyshev centre of the kernel, by min-norm ascent, the direction smoothing uses), then
+//! decided exactly: it is returned only if `orient3d` puts it strictly on the inner side of
+//! every face. A cell whose kernel is empty, or so thin that the ascent misses it, gives `None`.
+
+use crate::geom::filter::orient3d;
+use crate::geom::predicates::{Sign, in_exact_range};
+use crate::geom::vec3::{add, cross, dot, norm2, scale, sub};
+use crate::smooth::ascent::{MAX_ACTIVE, min_norm_point};
+
+type P3 = [f64; 3];
+
+/// Ascent iterations at most (each is linear in the number of faces).
+const MAX_STEPS: usize = 200;
+
+/// A point strictly inside the kernel of the cell bounded by `faces` (indices into `points`,
+/// normals into the cell), or `None`. Exact: every returned point passes `orient3d > 0` against
+/// every face.
+pub(crate) fn kernel_point(points: &[P3], faces: &[[u32; 3]]) -> Option<P3> {
+    if faces.len() < 4 {
+        return None;
+    }
+    // Unit inward normals and offsets, in coordinates centred on the cell (conditioning).
+    let mut centre = [0.0; 3];
+    let mut n = 0.0;
+    for f in faces {
+        for &x in f {
+            centre = add(centre, points[x as usize]);
+            n += 1.0;
+        }
+    }
+    centre = scale(centre, 1.0 / n);
+    let mut planes: Vec<(P3, f64)> = Vec::with_capacity(faces.len());
+    let mut diameter2: f64 = 0.0;
+    for f in faces {
+        let [a, b, c] = f.map(|x| sub(points[x as usize], centre));
+        diameter2 = diameter2.max(norm2(a));
+        let nrm = cross(sub(b, a), sub(c, a));
+        let len = norm2(nrm).sqrt();
+        if len == 0.0 || !len.is_finite() {
+            return None;
+        }
+        let u = scale(nrm, 1.0 / len);
+        planes.push((u, dot(u, a)));
+    }
+    let exact_ok = |x: P3| {
+        let p = add(x, centre);
+        p.iter().all(|&c| in_exact_range(c))
+            && faces.iter().all(|f| {
+                let [a, b, c] = f.map(|i| points[i as usize]);
+                orient3d(a, b, c, p) == Sign::Positive
+            })
+    };
+    // Smallest signed distance to the planes, positive inside.
+    let depth = |x: P3| {
+        planes
+            .iter()
+            .map(|&(u, d)| dot(u, x) - d)
+            .fold(f64::INFINITY, f64::min)
+    };
+    let mut x = [0.0; 3];
+    let mut fx = depth(x);
+    let mut step = diameter2.sqrt().max(f64::MIN_POSITIVE);
+    let mut active: Vec<(f64, usize)> = Vec::with_capacity(planes.len());
+    let mut grads: Vec<P3> = Vec::with_capacity(MAX_ACTIVE);
+    for _ in 0..MAX_STEPS {
+        if fx > 0.0 && exact_ok(x) {
+            return Some(add(x, centre));
+        }
+        // The planes nearly tied for the smallest distance, nearest first.
+        let tol = 1e-9 * step.max(fx.abs());
+        active.clear();
+        active.extend(
+            planes
+                .iter()
+                .enumerate()
+                .map(|(i, &(u, d))| (dot(u, x) - d, i))
+                .filter(|&(v, _)| v <= fx + tol.max(1e-3 * step)),
+        );
+        active.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        grads.clear();
+        grads.extend(active.iter().take(MAX_ACTIVE).map(|&(_, i)| planes[i].0));
+        let d = min_norm_point(&grads);
+        let dn = norm2(d).sqrt();
+        if dn < 1e-12 {
+            // Stationary: the kernel is empty, or its depth is what `fx` says.
+            break;
+        }
+        let d = scale(d, 1.0 / dn);
+        // Backtracking: the longest step (halving from the current scale) that raises depth.
+        let mut moved = false;
+        let mut s = step * 2.0;
+        for _ in 0..60 {
+            let y = add(x, scale(d, s));
+            let fy = depth(y);
+            if fy > fx {
+                x = y;
+                fx = fy;
+                step = s;
+                moved = true;
+                break;
+            }
+            s *= 0.5;
+        }
+        if !moved {
+            break;
+        }
+    }
+    (fx > 0.0 && exact_ok(x)).then(|| add(x, centre))
+}
+
+/// The cone from point `p` (index `apex`) over `faces`: one positively oriented tet per face
+/// when `p` is strictly inside the kernel.
+pub(crate) fn cone(faces: &[[u32; 3]], apex: u32) -> impl Iterator<Item = [u32; 4]> + '_ {
+    faces.iter().map(move |f| [f[0], f[1], f[2], apex])
+}
+
+/// Insert point `x` into the tets `tets` (indices into `points`) by splitting every tet whose
+/// closure holds it: each face of such a tet that `x` sees strictly from inside becomes a tet
+/// with `x` (four for a point inside, six for one on a face shared by two tets, two per tet
+/// around an edge). Exact. Returns whether `x` was in some tet; a point equal to a corner is
+/// left alone (`false`).
+pub(crate) fn split_insert(points: &[P3], tets: &mut Vec<[u32; 4]>, x: u32) -> bool {
+    use crate::mesh::tet::TET_FACES;
+    let p = points[x as usize];
+    let mut found = false;
+    let mut i = 0;
+    while i < tets.len() {
+        let t = tets[i];
+        let c = t.map(|v| points[v as usize]);
+        let signs = TET_FACES.map(|f| orient3d(c[f[0]], c[f[1]], c[f[2]], p));
+        // Faces point outward: inside is Negative for every face.
+        if signs.contains(&Sign::Positive) || t.contains(&x) {
+            i += 1;
+            continue;
+        }
+        if signs.iter().filter(|&&s| s == Sign::Zero).count() >= 3 {
+            // `p` is a corner's position (distinct points make this a corner itself).
+            i += 1;
+            continue;
+        }
+        found = true;
+        tets.swap_remove(i);
+        for (k, s) in signs.iter().enumerate() {
+            if *s == Sign::Negative {
+                let mut n = t;
+                n[k] = x;
+                tets.push(n);
+            }
+        }
+        // The pushed tets hold `x` and are skipped; `i` now holds an unvisited tet.
+    }
+    found
+}
