@@ -702,20 +702,8 @@ fn recover_puts_back_surface_points_the_mesh_dropped() {
     let s = crate::common::load_stl("brain_20k.stl");
     let mut m = delaunay_trimmed(&s);
     // Also the tets at every 97th point, as a mesher that lost them would.
-    let keep: Vec<bool> = m
-        .tets
-        .iter()
-        .map(|t| t.iter().all(|x| x % 97 != 0))
-        .collect();
-    let mut k = 0;
-    for t in 0..keep.len() {
-        if keep[t] {
-            m.tets[k] = m.tets[t];
-            k += 1;
-        }
-    }
-    m.tets.truncate(k);
-    m.labels.truncate(k);
+    m.tets.retain(|t| t.iter().all(|x| x % 97 != 0));
+    m.labels.truncate(m.tets.len());
     let mut used = vec![false; m.points.len()];
     for t in &m.tets {
         for &x in t {
