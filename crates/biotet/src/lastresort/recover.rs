@@ -44,13 +44,24 @@
 //!    front]`), so interfaces get the right label on each side. Tets of region 0 (the outside)
 //!    are removed.
 //!
-//! # Honest failure
-//! Some shells have no tetrahedralization without new points (the Schönhardt polyhedron). The
-//! report lists each unrecovered triangle with its corners, smallest angle and the reason; the
-//! seed's experience is that the root cause is a flawed or very poor input triangle. With
-//! [`RecoverOptions::allow_interior_steiner`], a failed cavity is searched again with one new
-//! point strictly inside it (the average of the cavity's points, when it is strictly inside a
-//! carved tet and on no surface triangle), on each ring of growth.
+//! # Steiner fallback and honest failure
+//! Some shells have no tetrahedralization without new points (the Schönhardt polyhedron, a
+//! cube whose face diagonals twist). Recovery stays total on valid input:
+//! - surface points the mesh lacks (or holds in no tet) are put back before anything else, by
+//!   splitting the tets that hold them ([`kernel::split_insert`](super::kernel)) or, outside
+//!   the mesh, by growing its convex hull to them;
+//! - the no-new-point queue is bounded by work: [`RecoverOptions::max_tries`] attempts a
+//!   triangle, [`RecoverOptions::max_grow`] rings, [`RecoverOptions::max_cavity_tets`] tets
+//!   and the search's node budget, so no triangle costs seconds;
+//! - with [`RecoverOptions::allow_interior_steiner`] (the default) the triangles left are tried
+//!   again, smallest cavities first; a cell with no fill of its own points gets one point
+//!   strictly inside its kernel (exact check, [`super::kernel`]): the fill through it the search
+//!   finds, or the cone from it. The point is strictly inside a cell, so never on the surface
+//!   (checked exactly against every surface triangle too). This alternates with the
+//!   no-new-point queue while either makes progress.
+//!
+//! What still fails (a cell that is star-shaped for no point, within the bounds) is reported:
+//! each unrecovered triangle with its corners, smallest angle and the reason.
 //!
 //! # Limits
 //! The surface must be valid (closed, oriented, not self-intersecting: [`crate::mesh::validate`]);
@@ -112,6 +123,14 @@ const CROSSED_MAX_TETS: usize = 64;
 
 /// Largest cavity of the Steiner fallback (see [`RecoverOptions::max_cavity_tets`]).
 const STEINER_MAX_TETS: usize = 300;
+
+/// Rings and largest cavity of the Steiner fallback once a round with the small ones made no
+/// progress (a surface triangle far larger than the interior spacing needs a wide cavity).
+const STEINER_GROW_WIDE: u32 = 6;
+const STEINER_MAX_TETS_WIDE: usize = 2000;
+/// The no-new-point queue's largest cavity and node budget in the wide rounds.
+const WIDE_MAX_TETS: usize = 1500;
+const WIDE_NODES: u64 = 2000;
 
 /// Rounds of the Steiner fallback, each followed by the no-new-point queue.
 const STEINER_ROUNDS: usize = 8;
@@ -317,8 +336,14 @@ fn recover_checked(
             r.tries.clear();
             r.run();
             let after = r.count_missing();
-            if after == 0 || after == before {
+            if after == 0 || (after == before && r.wide) {
                 break;
+            }
+            // Stuck with small cavities: the next rounds carve wider ones and search longer,
+            // with and without new points (a surface triangle far larger than the interior
+            // spacing needs a wide cavity).
+            if after == before {
+                r.widen();
             }
         }
     }
@@ -588,6 +613,8 @@ struct Recovery<'a> {
     steiner_points: usize,
     /// Failed serial attempts per triangle.
     tries: FxHashMap<u32, u8>,
+    /// The Steiner fallback carves wider cavities (after a round without progress).
+    wide: bool,
 }
 
 /// Stamped marks and buffers of the read-only stages (walks, carving, searches): one for the
@@ -1420,6 +1447,7 @@ impl<'a> Recovery<'a> {
             grown: 0,
             steiner_points: 0,
             tries: FxHashMap::default(),
+            wide: false,
         };
         r.index();
         r
@@ -1723,7 +1751,9 @@ impl<'a> Recovery<'a> {
         });
         // The fallback may need a wider cavity to find a star-shaped cell; it runs once per
         // triangle, so it gets more rings than the no-new-point search.
-        let rings = if kernel {
+        let rings = if kernel && self.wide {
+            self.opts.max_grow.max(STEINER_GROW_WIDE)
+        } else if kernel {
             self.opts.max_grow.max(STEINER_GROW)
         } else {
             self.opts.max_grow
@@ -1733,7 +1763,9 @@ impl<'a> Recovery<'a> {
                 self.grown += 1;
                 self.with_work(|view, w| view.grow(w, &mut tets));
             }
-            let cap = if kernel {
+            let cap = if kernel && self.wide {
+                self.opts.max_cavity_tets.max(STEINER_MAX_TETS_WIDE)
+            } else if kernel {
                 self.opts.max_cavity_tets.max(STEINER_MAX_TETS)
             } else {
                 self.opts.max_cavity_tets
@@ -1924,6 +1956,14 @@ impl<'a> Recovery<'a> {
             }
             crate::geom::intersect::seg_tri(p, p, &c).meets()
         })
+    }
+
+    /// Switch to the wide bounds for the rounds left (see [`STEINER_GROW_WIDE`]).
+    fn widen(&mut self) {
+        self.wide = true;
+        self.opts.max_grow = self.opts.max_grow.max(STEINER_GROW_WIDE);
+        self.opts.max_cavity_tets = self.opts.max_cavity_tets.max(WIDE_MAX_TETS);
+        self.opts.search.max_nodes = self.opts.search.max_nodes.max(WIDE_NODES);
     }
 
     /// Coordinates of the surface points (once each) that are no mesh point or a mesh point in
