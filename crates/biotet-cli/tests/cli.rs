@@ -255,35 +255,12 @@ fn bad_surfaces_get_a_clear_error() {
         let first: Vec<[usize; 3]> = t.clone();
         t.extend(first.iter().map(|f| f.map(|v| v + o)));
     });
-    // A second cube sharing only the edge (1,1,z) of the first: a non-manifold edge.
-    let nonmanifold = cube_off(|t, p| {
-        let mut map = [0usize; 8];
-        for (i, slot) in map.iter_mut().enumerate() {
-            let q = [
-                1.0 + (i & 1) as f64,
-                1.0 + ((i >> 1) & 1) as f64,
-                ((i >> 2) & 1) as f64,
-            ];
-            *slot = match p.iter().position(|x| *x == q) {
-                Some(j) => j,
-                None => {
-                    p.push(q);
-                    p.len() - 1
-                }
-            };
-        }
-        let first: Vec<[usize; 3]> = t.clone();
-        t.extend(first.iter().map(|f| f.map(|v| map[v])));
-    });
+    // (Two cubes sharing only an edge are valid: two regions, see
+    // shells_touching_along_an_edge_or_at_a_vertex_are_two_regions.)
     for (name, text, words) in [
         ("hole.off", hole, &["hole.off", "closed"][..]),
         ("flipped.off", flipped, &["flipped.off", "orient"][..]),
         ("crossing.off", crossing, &["crossing.off", "intersect"][..]),
-        (
-            "nonmanifold.off",
-            nonmanifold,
-            &["nonmanifold.off", "manifold"][..],
-        ),
     ] {
         let (out, _, _d) = validate_text(name, &text);
         assert_eq!(out.status.code(), Some(1), "{name} must be refused");
@@ -1433,5 +1410,171 @@ fn mesh_and_recover_help_end_with_examples_of_the_steiner_and_failure_flags() {
         assert!(text[..examples].contains("--keep-failed"), "{text}");
         // The former opt-in is accepted but not shown.
         assert!(!text.contains("--allow-interior-steiner"), "{text}");
+    }
+}
+
+/// Unit cubes at integer `cells` as one OFF surface: faces shared by two cubes removed, each
+/// remaining square split along one diagonal (`other`: the other one, per cube).
+fn cubes_off(cells: &[([i32; 3], bool)]) -> String {
+    let quads = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    let mut squares: Vec<([[i32; 3]; 4], bool)> = Vec::new();
+    for &(o, other) in cells {
+        let c = |i: usize| {
+            [
+                o[0] + (i & 1) as i32,
+                o[1] + ((i >> 1) & 1) as i32,
+                o[2] + (i >> 2) as i32,
+            ]
+        };
+        for q in quads {
+            squares.push((q.map(c), other));
+        }
+    }
+    let key = |q: &[[i32; 3]; 4]| {
+        let mut k = *q;
+        k.sort_unstable();
+        k
+    };
+    let mut pts: Vec<[i32; 3]> = Vec::new();
+    let mut tris: Vec<[usize; 3]> = Vec::new();
+    for (q, other) in &squares {
+        if squares.iter().filter(|(r, _)| key(r) == key(q)).count() > 1 {
+            continue;
+        }
+        let id: Vec<usize> = (0..4)
+            .map(|i| {
+                let p = q[(i + *other as usize) % 4];
+                pts.iter().position(|x| *x == p).unwrap_or_else(|| {
+                    pts.push(p);
+                    pts.len() - 1
+                })
+            })
+            .collect();
+        tris.push([id[0], id[1], id[2]]);
+        tris.push([id[0], id[2], id[3]]);
+    }
+    let mut s = format!("OFF\n{} {} 0\n", pts.len(), tris.len());
+    for p in &pts {
+        s += &format!("{} {} {}\n", p[0], p[1], p[2]);
+    }
+    for t in &tris {
+        s += &format!("3 {} {} {}\n", t[0], t[1], t[2]);
+    }
+    s
+}
+
+#[test]
+fn shells_touching_along_an_edge_or_at_a_vertex_are_two_regions() {
+    // [0,1]^3 with [1,2]x[1,2]x[0,1] (sharing the edge (1,1,0)-(1,1,1)), or with [1,2]^3
+    // (sharing the vertex (1,1,1)): validate accepts what mesh accepts, and says where the
+    // shells touch; the mesh has two regions, each with its whole boundary, and passes check.
+    let dir = tempfile::tempdir().unwrap();
+    for (name, b, note, touching) in [
+        (
+            "edge.off",
+            [1, 1, 0],
+            [
+                "shells touch along edge (",
+                ") (1, 1, 0)–(1, 1, 1): kept as an edge shared by regions 1 and 2",
+            ],
+            2,
+        ),
+        (
+            "vertex.off",
+            [1, 1, 1],
+            [
+                "shells touch at vertex ",
+                " (1, 1, 1): kept as a vertex shared by regions 1 and 2",
+            ],
+            1,
+        ),
+    ] {
+        let off = dir.path().join(name);
+        std::fs::write(&off, cubes_off(&[([0, 0, 0], false), (b, true)])).unwrap();
+        let v = biotet(&["validate", s(&off)]);
+        assert!(v.status.success(), "{name}: {}", stderr(&v));
+        for w in note {
+            assert!(stderr(&v).contains(w), "{name}: {}", stderr(&v));
+        }
+        let vtu = dir.path().join("out.vtu");
+        let m = biotet(&["mesh", s(&off), "-o", s(&vtu)]);
+        assert!(m.status.success(), "{name}: {}", stderr(&m));
+        assert!(stderr(&m).contains(note[1]), "{name}: {}", stderr(&m));
+        let c = json_of(&biotet(&["check", s(&vtu), "--surface", s(&off), "--json"]));
+        assert_eq!(c["valid"], true, "{name}: {c}");
+        assert_eq!(c["n_touching_vertices"], touching, "{name}: {c}");
+        let regions: Vec<u64> = c["regions"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|r| r["label"].as_u64().unwrap())
+            .collect();
+        assert_eq!(regions, vec![1, 2], "{name}: {c}");
+        for i in c["surface"]["interfaces"].as_array().unwrap() {
+            assert_eq!(
+                (&i["expected"], &i["found"]),
+                (&12.into(), &12.into()),
+                "{c}"
+            );
+        }
+        assert_eq!(c["surface"]["interfaces"].as_array().unwrap().len(), 2);
+    }
+}
+
+#[test]
+fn a_region_pinched_at_an_edge_is_refused_naming_the_edge() {
+    let dir = tempfile::tempdir().unwrap();
+    // One shell: cubes [0,1]^3 and [1,2]x[1,2]x[0,1] joined above through [0,1]x[0,2]x[1,2]
+    // and [1,2]^3, so one region pinched at the edge (1,1,0)-(1,1,1).
+    let ring = dir.path().join("ring.off");
+    let cells = [[0, 0, 0], [1, 1, 0], [0, 0, 1], [0, 1, 1], [1, 1, 1]];
+    let cells: Vec<_> = cells.iter().map(|&c| (c, false)).collect();
+    std::fs::write(&ring, cubes_off(&cells)).unwrap();
+    // A bow-tie of two tets sharing the edge (0,0,0)-(0,0,1), labelled as one region.
+    let bowtie = dir.path().join("bowtie.ply");
+    let pts = ["0 0 0", "0 0 1", "1 0 0", "0 1 0", "-1 0 0", "0 -1 0"];
+    let faces = [
+        [0, 3, 2],
+        [0, 2, 1],
+        [0, 1, 3],
+        [1, 2, 3],
+        [0, 5, 4],
+        [0, 4, 1],
+        [0, 1, 5],
+        [1, 4, 5],
+    ];
+    let mut ply = format!(
+        "ply\nformat ascii 1.0\nelement vertex 6\nproperty double x\nproperty double y\n\
+         property double z\nelement face 8\nproperty list uchar int vertex_indices\n\
+         property int label_back\nproperty int label_front\nend_header\n{}\n",
+        pts.join("\n")
+    );
+    for f in faces {
+        ply += &format!("3 {} {} {} 1 0\n", f[0], f[1], f[2]);
+    }
+    std::fs::write(&bowtie, ply).unwrap();
+    for (f, edge) in [
+        (&ring, "(1, 1, 0)–(1, 1, 1) in 4 triangles"),
+        (&bowtie, "(0, 0, 0)–(0, 0, 1) in 4 triangles"),
+    ] {
+        let v = biotet(&["validate", s(f)]);
+        assert_eq!(v.status.code(), Some(1), "{}", stderr(&v));
+        let msg = stderr(&v);
+        assert!(
+            msg.contains("non-manifold edges") && msg.contains(edge) && msg.contains(s(f)),
+            "{msg}"
+        );
+        let out = dir.path().join("out.vtu");
+        let m = biotet(&["mesh", s(f), "-o", s(&out)]);
+        assert_eq!(m.status.code(), Some(1), "{}", stderr(&m));
+        assert!(stderr(&m).contains(edge), "{}", stderr(&m));
+        assert!(!out.exists());
     }
 }

@@ -8,7 +8,9 @@ use crate::geom::predicates::{Sign, in_exact_range, orient3d};
 use crate::mesh::coord_key;
 use crate::mesh::surface::SurfaceMesh;
 use crate::mesh::tet::{NO_NEIGHBOR, TET_FACES, TetMesh, sorted3};
-use crate::mesh::validate::{ValidateOptions, validate_surface};
+use crate::mesh::validate::{
+    SurfaceError, TriangleInfo, ValidateOptions, check_self_intersections, validate_surface,
+};
 use rustc_hash::FxHashMap;
 use serde::Serialize;
 use std::fmt;
@@ -50,6 +52,10 @@ pub struct CheckReport {
     /// when they do). Together with positive tets and conforming faces this proves that the
     /// tets cover their domain exactly once: no overlap, no fold.
     pub boundary_problem: Option<String>,
+    /// Boundary vertices where the mesh touches itself (its boundary is not a manifold there:
+    /// two shells meet only at that vertex or along an edge through it) and every sheet belongs
+    /// to different regions: regions touching, not a region pinched. Legitimate; informational.
+    pub n_touching_vertices: usize,
     /// Surface conformity, when a surface was given.
     pub surface: Option<SurfaceConformity>,
     /// Per region label (by increasing label): tets, volume, worst angles and, with a surface,
@@ -356,7 +362,9 @@ pub fn check(mesh: &TetMesh, surface: Option<&SurfaceMesh>) -> CheckReport {
         && r.n_misoriented_faces == 0
         && r.n_nonfinite_points == 0;
     if locally_ok && !mesh.tets.is_empty() {
-        r.boundary_problem = boundary_embedding(mesh, &boundary);
+        let (problem, touching) = boundary_embedding(mesh, &boundary, &keys);
+        r.boundary_problem = problem;
+        r.n_touching_vertices = touching;
         if let Some(p) = &r.boundary_problem {
             r.problems.push(format!("boundary surface: {p}"));
         }
@@ -397,10 +405,16 @@ pub fn check(mesh: &TetMesh, surface: Option<&SurfaceMesh>) -> CheckReport {
 /// with conforming faces cover each point a number of times equal to the winding number of
 /// their boundary around it, so an embedded outward boundary means every point of the domain is
 /// covered exactly once: this finds tets that overlap without sharing a face.
+///
+/// Regions may touch: two shells meeting only along an edge or at a vertex make the boundary
+/// non-manifold there, which is legitimate when the tets on the two sheets belong to different
+/// regions, and a region pinched when they share one ([`touching_boundary`]). Returns the
+/// problem, if any, and the number of boundary vertices where regions touch.
 fn boundary_embedding(
     mesh: &TetMesh,
     boundary: &FxHashMap<[u32; 3], (u32, u32)>,
-) -> Option<String> {
+    face_keys: &[([u32; 3], u32)],
+) -> (Option<String>, usize) {
     let mut faces: Vec<(u32, u32)> = boundary.values().copied().collect();
     faces.sort_unstable();
     let triangles: Vec<[u32; 3]> = faces
@@ -412,9 +426,205 @@ fn boundary_embedding(
         fix_inward: false,
         ..ValidateOptions::default()
     };
-    validate_surface(&mut surface, &opts)
-        .err()
-        .map(|e| format!("{e} (triangle indices are boundary faces in (tet, face) order)"))
+    let show =
+        |e: SurfaceError| format!("{e} (triangle indices are boundary faces in (tet, face) order)");
+    match validate_surface(&mut surface, &opts) {
+        Ok(_) => (None, 0),
+        Err(SurfaceError::NonManifoldEdge { .. } | SurfaceError::NonManifoldVertex { .. }) => {
+            let (problem, touching) = touching_boundary(mesh, &faces, &surface, face_keys);
+            (problem.map(show), touching)
+        }
+        Err(e) => (Some(show(e)), 0),
+    }
+}
+
+/// [`boundary_embedding`] for a boundary that is not a manifold (`surface`: the boundary
+/// `faces` as one closed surface). At each vertex the tets around it fall into classes, tets
+/// joined through their shared faces at the vertex; classes that share a region label are one
+/// group (a region is one piece there). Where a vertex has several groups, the regions of each
+/// group touch the others only at that vertex (or along an edge through it), and each group gets
+/// its own copy of the vertex: the boundary, so unpinched, must then pass every check of
+/// [`validate_surface`] but self-intersection, which is checked on the boundary as it is
+/// (sheets that touch share their vertices there). A region pinched at an edge or a vertex keeps
+/// its sheets on one copy and fails as a non-manifold edge or vertex, with the mesh's indices.
+fn touching_boundary(
+    mesh: &TetMesh,
+    faces: &[(u32, u32)],
+    surface: &SurfaceMesh,
+    face_keys: &[([u32; 3], u32)],
+) -> (Option<SurfaceError>, usize) {
+    let nt = mesh.tets.len();
+    let np = mesh.points.len();
+    let corner = |t: usize, v: u32| mesh.tets[t].iter().position(|&x| x == v).unwrap_or(0);
+    // Tet corners 4t + i joined across interior faces at each of the face's vertices.
+    let mut dsu: Vec<u32> = (0..4 * nt as u32).collect();
+    fn find(p: &mut [u32], mut x: u32) -> u32 {
+        while p[x as usize] != x {
+            p[x as usize] = p[p[x as usize] as usize];
+            x = p[x as usize];
+        }
+        x
+    }
+    for w in face_keys.windows(2) {
+        if w[0].0 != w[1].0 {
+            continue;
+        }
+        let (ta, tb) = ((w[0].1 >> 2) as usize, (w[1].1 >> 2) as usize);
+        for v in w[0].0 {
+            let a = find(&mut dsu, (4 * ta + corner(ta, v)) as u32);
+            let b = find(&mut dsu, (4 * tb + corner(tb, v)) as u32);
+            if a != b {
+                dsu[a.max(b) as usize] = a.min(b);
+            }
+        }
+    }
+    // (vertex, class, label) of every corner; per vertex, classes sharing a label merged.
+    let mut at: Vec<(u32, u32, u32)> = (0..4 * nt)
+        .map(|c| {
+            let t = c / 4;
+            let label = mesh.labels.get(t).copied().unwrap_or(0);
+            (mesh.tets[t][c % 4], find(&mut dsu, c as u32), label)
+        })
+        .collect();
+    at.sort_unstable();
+    at.dedup();
+    let mut points = mesh.points.clone();
+    let mut copy_of: FxHashMap<u32, u32> = FxHashMap::default(); // class -> vertex copy
+    let mut original: Vec<u32> = (0..np as u32).collect();
+    let mut touching = vec![false; np];
+    let mut n_touching = 0;
+    let mut i = 0;
+    while i < at.len() {
+        let v = at[i].0;
+        let mut j = i + 1;
+        while j < at.len() && at[j].0 == v {
+            j += 1;
+        }
+        let mut classes: Vec<u32> = at[i..j].iter().map(|x| x.1).collect();
+        classes.dedup();
+        if classes.len() > 1 {
+            // Union of classes through labels (few: a vertex's classes).
+            let mut group: Vec<usize> = (0..classes.len()).collect();
+            let root = |g: &[usize], mut k: usize| {
+                while g[k] != k {
+                    k = g[k];
+                }
+                k
+            };
+            for a in i..j {
+                for b in a + 1..j {
+                    if at[a].2 == at[b].2 {
+                        let ka = classes.binary_search(&at[a].1).unwrap_or(0);
+                        let kb = classes.binary_search(&at[b].1).unwrap_or(0);
+                        let (ra, rb) = (root(&group, ka), root(&group, kb));
+                        group[ra.max(rb)] = ra.min(rb);
+                    }
+                }
+            }
+            let roots: Vec<usize> = (0..classes.len()).map(|k| root(&group, k)).collect();
+            if roots.iter().any(|&r| r != 0) {
+                n_touching += 1;
+                touching[v as usize] = true;
+                let mut index_of: FxHashMap<usize, u32> = FxHashMap::default();
+                for (k, &r) in roots.iter().enumerate() {
+                    let idx = *index_of.entry(r).or_insert_with(|| {
+                        if r == 0 {
+                            v
+                        } else {
+                            points.push(mesh.points[v as usize]);
+                            original.push(v);
+                            (points.len() - 1) as u32
+                        }
+                    });
+                    copy_of.insert(classes[k], idx);
+                }
+            }
+        }
+        i = j;
+    }
+    touching.resize(points.len(), true);
+    // The unpinched boundary. Nesting is judged from each shell's lowest triangle's first
+    // corner, which must lie on no other shell: put a corner where nothing touches first, and
+    // triangles without one last.
+    let mut tris: Vec<(bool, usize, [u32; 3])> = faces
+        .iter()
+        .enumerate()
+        .map(|(k, &(t, f))| {
+            let t = t as usize;
+            let mut tri = mesh.face(t, f as usize).map(|v| {
+                let class = find(&mut dsu, (4 * t + corner(t, v)) as u32);
+                copy_of.get(&class).copied().unwrap_or(v)
+            });
+            if let Some(r) = (0..3).find(|&r| !touching[tri[r] as usize]) {
+                tri.rotate_left(r);
+            }
+            (touching[tri[0] as usize], k, tri)
+        })
+        .collect();
+    tris.sort_by_key(|x| (x.0, x.1));
+    let order: Vec<u32> = tris.iter().map(|x| x.1 as u32).collect();
+    let mut split = SurfaceMesh::closed(points, tris.iter().map(|x| x.2).collect(), 1);
+    let opts = ValidateOptions {
+        self_intersections: false,
+        fix_inward: false,
+        ..ValidateOptions::default()
+    };
+    if let Err(mut e) = validate_surface(&mut split, &opts) {
+        restore_indices(&mut e, &original, &order, surface);
+        return (Some(e), n_touching);
+    }
+    (
+        check_self_intersections(surface, opts.max_examples).err(),
+        n_touching,
+    )
+}
+
+/// Give an error about the unpinched boundary of [`touching_boundary`] the boundary's own
+/// indices: vertex copies as their `original`, triangle `k` as `order[k]`.
+fn restore_indices(e: &mut SurfaceError, original: &[u32], order: &[u32], s: &SurfaceMesh) {
+    let v = |x: u32| original.get(x as usize).copied().unwrap_or(x);
+    let t = |x: u32| order.get(x as usize).copied().unwrap_or(x);
+    let tri = |x: &mut TriangleInfo| {
+        x.index = t(x.index);
+        x.vertices = s.triangles[x.index as usize];
+        x.corners = s.corners(x.index as usize);
+    };
+    match e {
+        SurfaceError::NotClosed { first, .. } | SurfaceError::NonManifoldEdge { first, .. } => {
+            for x in first {
+                let [a, b] = x.edge.map(v);
+                x.edge = [a.min(b), a.max(b)];
+                x.triangles.iter_mut().for_each(tri);
+            }
+        }
+        SurfaceError::NonManifoldVertex { first, .. } => {
+            for x in first {
+                x.vertex = v(x.vertex);
+                x.triangles.iter_mut().for_each(|k| *k = t(*k));
+            }
+        }
+        SurfaceError::Degenerate { first, .. } | SurfaceError::NonOrientable { first, .. } => {
+            first.iter_mut().for_each(tri);
+        }
+        SurfaceError::Flipped { first, to_flip, .. } => {
+            first.iter_mut().for_each(tri);
+            to_flip.iter_mut().for_each(|k| *k = t(*k));
+            to_flip.sort_unstable();
+        }
+        SurfaceError::Duplicate { first, .. } | SurfaceError::SelfIntersection { first, .. } => {
+            for p in first {
+                tri(&mut p.0);
+                tri(&mut p.1);
+            }
+        }
+        SurfaceError::Inward { first, .. }
+        | SurfaceError::LabelsContradictGeometry { first, .. } => {
+            for x in first {
+                tri(&mut x.triangle);
+            }
+        }
+        _ => {}
+    }
 }
 
 fn show_nb(n: u32) -> String {
@@ -602,6 +812,18 @@ impl fmt::Display for CheckReport {
             if n > 0 {
                 writeln!(f, "  {n} {what}")?;
             }
+        }
+        if self.n_touching_vertices > 0 {
+            writeln!(
+                f,
+                "  different regions touch at {} boundary {} (a shared vertex or edge, not a face)",
+                self.n_touching_vertices,
+                if self.n_touching_vertices == 1 {
+                    "vertex"
+                } else {
+                    "vertices"
+                }
+            )?;
         }
         if let Some(s) = &self.surface {
             writeln!(

@@ -34,38 +34,6 @@ pub fn tet_mesh(path: &Path, common: Common) -> Result<TetMesh> {
     Ok(read.mesh)
 }
 
-/// Read and validate a closed surface. Refuses invalid surfaces with an error naming the file;
-/// flips an inward-oriented surface and says so. A file with side labels is checked as
-/// [`side_labelled`] does.
-pub fn surface(path: &Path, common: Common) -> Result<(SurfaceMesh, ValidationReport)> {
-    let read = biotet_io::read_surface(path)?;
-    if read.side_labels.is_some() {
-        let (mesh, _, report) = side_labelled(path, read, common)?;
-        return Ok((mesh, report));
-    }
-    let mut mesh = read.mesh;
-    let report = validate_surface(&mut mesh, &ValidateOptions::default())
-        .with_context(|| format!("{}: invalid surface", path.display()))?;
-    if !common.quiet && !common.json {
-        if read.welded > 0 {
-            eprintln!(
-                "note: {}: welded {} duplicate vertices",
-                path.display(),
-                read.welded
-            );
-        }
-        if report.flipped_inward {
-            eprintln!(
-                "note: {}: {} of {} triangles faced inward and were flipped",
-                path.display(),
-                report.n_flipped_triangles,
-                report.n_triangles
-            );
-        }
-    }
-    Ok((mesh, report))
-}
-
 /// A surface whose file gives the region labels on both sides of its triangles (see
 /// `biotet::mesh::side_labels`): the per-region checks of `validate_surface` (closed,
 /// consistently oriented, no crossing triangles) and the labels against the cells of the
@@ -143,6 +111,18 @@ pub fn labelled_surface(
     common: Common,
     stage: &Stage,
 ) -> Result<(SurfaceMesh, Vec<Shell>, String)> {
+    let (s, shells, _, name) = labelled_surface_report(paths, labels, common, stage)?;
+    Ok((s, shells, name))
+}
+
+/// [`labelled_surface`] with the validation report: what `biotet mesh` reads, as `biotet
+/// validate` judges it.
+pub fn labelled_surface_report(
+    paths: &[PathBuf],
+    labels: &[String],
+    common: Common,
+    stage: &Stage,
+) -> Result<(SurfaceMesh, Vec<Shell>, ValidationReport, String)> {
     let labels = parse_labels(labels, paths)?;
     let mut parts = Vec::new();
     for (i, p) in paths.iter().enumerate() {
@@ -163,8 +143,9 @@ pub fn labelled_surface(
                 );
             }
             stage.set("validating the surface");
-            let (s, shells, _) = side_labelled(p, read, common)?;
-            return Ok((s, shells, p.display().to_string()));
+            let (s, shells, report) = side_labelled(p, read, common)?;
+            note_touching(&s, &p.display().to_string(), common);
+            return Ok((s, shells, report, p.display().to_string()));
         }
         if read.welded > 0 && !common.quiet && !common.json {
             eprintln!(
@@ -184,8 +165,8 @@ pub fn labelled_surface(
         .collect::<Vec<_>>()
         .join(" + ");
     stage.set("validating the surface");
-    let (s, shells) = assemble_parts(parts, &name, paths, common)?;
-    Ok((s, shells, name))
+    let (s, shells, report) = assemble_validated(parts, &name, paths, common)?;
+    Ok((s, shells, report, name))
 }
 
 /// Assemble and validate parts, telling the user about flipped shells and regions.
@@ -195,9 +176,60 @@ pub fn assemble_parts(
     paths: &[PathBuf],
     common: Common,
 ) -> Result<(SurfaceMesh, Vec<Shell>)> {
+    let (s, shells, _) = assemble_validated(parts, name, paths, common)?;
+    Ok((s, shells))
+}
+
+/// Tell the user where regions touch only along an edge or at a vertex: legitimate (each
+/// region's boundary is whole), the edge or vertex shared by the regions in the mesh.
+fn note_touching(s: &SurfaceMesh, name: &str, common: Common) {
+    if common.quiet || common.json {
+        return;
+    }
+    let t = biotet::mesh::shells::touching(s);
+    let p = |v: u32| {
+        let q = s.points[v as usize];
+        format!("({}, {}, {})", q[0], q[1], q[2])
+    };
+    let regions = |r: &[u32]| {
+        let r: Vec<String> = r.iter().map(|x| x.to_string()).collect();
+        r.join(" and ")
+    };
+    const SHOWN: usize = 5;
+    for (e, r) in t.edges.iter().take(SHOWN) {
+        eprintln!(
+            "note: {name}: shells touch along edge ({}, {}) {}–{}: kept as an edge shared by \
+             regions {}",
+            e[0],
+            e[1],
+            p(e[0]),
+            p(e[1]),
+            regions(r)
+        );
+    }
+    for (v, r) in t.vertices.iter().take(SHOWN) {
+        eprintln!(
+            "note: {name}: shells touch at vertex {v} {}: kept as a vertex shared by regions {}",
+            p(*v),
+            regions(r)
+        );
+    }
+    let more = t.edges.len().saturating_sub(SHOWN) + t.vertices.len().saturating_sub(SHOWN);
+    if more > 0 {
+        eprintln!("note: {name}: and {more} more edges or vertices where shells touch");
+    }
+}
+
+/// [`assemble_parts`] with the validation report.
+fn assemble_validated(
+    parts: Vec<Part>,
+    name: &str,
+    paths: &[PathBuf],
+    common: Common,
+) -> Result<(SurfaceMesh, Vec<Shell>, ValidationReport)> {
     let (mut surface, shells) =
         assemble(parts).with_context(|| format!("{name}: cannot assemble the surfaces"))?;
-    validate_surface(&mut surface, &ValidateOptions::default())
+    let report = validate_surface(&mut surface, &ValidateOptions::default())
         .with_context(|| format!("{name}: invalid surface"))?;
     if !common.quiet && !common.json {
         for (k, sh) in shells.iter().enumerate() {
@@ -222,7 +254,8 @@ pub fn assemble_parts(
             eprintln!("note: {} shells, regions {}", shells.len(), desc.join(", "));
         }
     }
-    Ok((surface, shells))
+    note_touching(&surface, name, common);
+    Ok((surface, shells, report))
 }
 
 /// [`labelled_surface`] for commands whose surface is optional (`None` without paths).

@@ -17,11 +17,19 @@ pub struct Args {
 }
 
 /// Run `biotet validate`: exits 1 at the first invalid surface, naming it and the problem.
+/// Each file is judged as `biotet mesh` reads it alone: its closed shells assembled into
+/// regions (shells touching along an edge or at a vertex are separate regions sharing it, and
+/// the user is told), then validated region by region.
 pub fn run(a: Args) -> Result<ExitCode> {
     let mut out = Vec::new();
     for path in &a.surfaces {
         let stage = Stage::start(a.common.quiet, format!("validating {}", path.display()));
-        let (mesh, report) = super::input::surface(path, a.common)?;
+        let (mesh, _, report, _) = super::input::labelled_surface_report(
+            std::slice::from_ref(path),
+            &[],
+            a.common,
+            &stage,
+        )?;
         drop(stage);
         if !a.common.quiet && !a.common.json {
             crate::emit(&format!(

@@ -14,9 +14,11 @@
 //! into cells by their exact angular order around every edge; nested cells are resolved by exact
 //! point location; each bounded region gets a label.
 //!
-//! Limits: shells touching only along an edge or at a vertex (without a shared triangle) join
-//! into one component; a shell sharing triangles with the shell around it is refused; a
-//! non-manifold part must be the only part.
+//! Shells touching only along an edge (no shared triangle) make their part non-manifold: it is
+//! labelled from its arrangement, each shell its own region, the edge shared by them; shells
+//! touching only at a vertex are separate components, each its own region. [`touching`] lists
+//! such edges and vertices. Limits: a shell sharing triangles with the shell around it is
+//! refused; a non-manifold part must be the only part.
 //! [`crate::mesh::validate`] checks the result (closed regions, no intersections).
 
 use rustc_hash::FxHashMap;
@@ -469,4 +471,87 @@ pub fn assemble(parts: Vec<Part>) -> Result<(SurfaceMesh, Vec<Shell>), AssembleE
         },
         shells,
     ))
+}
+
+/// Where the regions of a labelled surface touch only along an edge or at a vertex: the outer
+/// boundary of the union of the regions (the triangles with the outside, label 0, on one side)
+/// is not a manifold there, though each region's boundary is. See [`touching`].
+#[derive(Debug, Clone, Default, PartialEq, Eq, serde::Serialize)]
+pub struct Touching {
+    /// Edges in more than two outer triangles, with the regions that meet there.
+    pub edges: Vec<([u32; 2], Vec<u32>)>,
+    /// Vertices (not on such an edge) where the outer triangles form more than one fan, with
+    /// the regions that meet there.
+    pub vertices: Vec<(u32, Vec<u32>)>,
+}
+
+/// The edges and vertices where regions of `s` touch (combinatorial: by vertex indices). On a
+/// surface that passes [`crate::mesh::validate::validate_surface`] each region is a manifold on
+/// its own, so every sheet meeting there belongs to a different region.
+pub fn touching(s: &SurfaceMesh) -> Touching {
+    let outer: Vec<usize> = (0..s.triangles.len())
+        .filter(|&t| s.sides.get(t).is_some_and(|x| x.contains(&0)))
+        .collect();
+    let mut at_edge: FxHashMap<[u32; 2], Vec<usize>> = Default::default();
+    for &t in &outer {
+        let v = s.triangles[t];
+        for k in 0..3 {
+            let (a, b) = (v[k], v[(k + 1) % 3]);
+            at_edge.entry([a.min(b), a.max(b)]).or_default().push(t);
+        }
+    }
+    let regions = |ts: &mut dyn Iterator<Item = usize>| {
+        let mut r: Vec<u32> = ts.flat_map(|t| s.sides[t]).filter(|&l| l != 0).collect();
+        r.sort_unstable();
+        r.dedup();
+        r
+    };
+    let mut out = Touching::default();
+    let mut on_edge: rustc_hash::FxHashSet<u32> = Default::default();
+    // Fans: corners (3t + k) of outer triangles joined across edges with two outer triangles.
+    let mut parent: FxHashMap<usize, usize> = Default::default();
+    fn find(p: &mut FxHashMap<usize, usize>, mut x: usize) -> usize {
+        while let Some(&y) = p.get(&x).filter(|&&y| y != x) {
+            x = y;
+        }
+        x
+    }
+    let corner =
+        |t: usize, v: u32| 3 * t + s.triangles[t].iter().position(|&x| x == v).unwrap_or(0);
+    let mut edges: Vec<_> = at_edge.into_iter().collect();
+    edges.sort_unstable();
+    for (e, ts) in &edges {
+        match ts.len() {
+            2 => {
+                for v in e {
+                    let a = find(&mut parent, corner(ts[0], *v));
+                    let b = find(&mut parent, corner(ts[1], *v));
+                    if a != b {
+                        parent.insert(a.max(b), a.min(b));
+                    }
+                }
+            }
+            n if n > 2 => {
+                out.edges.push((*e, regions(&mut ts.iter().copied())));
+                on_edge.extend(e);
+            }
+            _ => {}
+        }
+    }
+    let mut fans: Vec<(u32, usize, usize)> = Vec::new(); // (vertex, fan, triangle)
+    for &t in &outer {
+        for v in s.triangles[t] {
+            fans.push((v, find(&mut parent, corner(t, v)), t));
+        }
+    }
+    fans.sort_unstable();
+    for run in fans.chunk_by(|a, b| a.0 == b.0) {
+        let v = run[0].0;
+        if on_edge.contains(&v) || run.windows(2).all(|w| w[0].1 == w[1].1) {
+            continue;
+        }
+        out.vertices
+            .push((v, regions(&mut run.iter().map(|x| x.2))));
+    }
+    out
 }

@@ -1,6 +1,6 @@
 //! The validity checker finds each kind of defect, and only those.
 
-use crate::common::{cube_points, cube_surface, cube6, two_cubes};
+use crate::common::{cube_points, cube_surface, cube6, cube6_tets, orient_all, two_cubes};
 use biotet::check::check;
 use biotet::{NO_NEIGHBOR, SurfaceMesh, TetMesh};
 
@@ -256,4 +256,101 @@ fn coordinates_outside_the_exact_range_are_reported() {
     let r = check(&m, None);
     assert!(!r.valid);
     assert_eq!(r.n_nonfinite_points, 7, "{r}"); // every corner but the origin
+}
+
+/// Unit cubes of 6 tets each at `origins`, with labels, sharing the points they have in common.
+fn cubes(origins: &[[f64; 3]], labels: &[u32]) -> TetMesh {
+    let mut pts: Vec<[f64; 3]> = Vec::new();
+    let mut tets = Vec::new();
+    let mut tet_labels = Vec::new();
+    for (o, &l) in origins.iter().zip(labels) {
+        let map: Vec<u32> = cube_points(*o, 1.0)
+            .into_iter()
+            .map(|p| match pts.iter().position(|q| *q == p) {
+                Some(i) => i as u32,
+                None => {
+                    pts.push(p);
+                    pts.len() as u32 - 1
+                }
+            })
+            .collect();
+        for t in cube6_tets(0) {
+            tets.push(t.map(|v| map[v as usize]));
+            tet_labels.push(l);
+        }
+    }
+    orient_all(&pts, &mut tets);
+    TetMesh::new(pts, tets, tet_labels)
+}
+
+#[test]
+fn regions_touching_along_an_edge_or_at_a_vertex_are_valid() {
+    // Cubes [0,1]^3 and [1,2]x[1,2]x[0,1] share the edge (1,1,0)-(1,1,1); [1,2]^3 shares only
+    // the vertex (1,1,1). The boundary is not a manifold there, but its sheets belong to
+    // different regions.
+    for (b, touching) in [([1.0, 1.0, 0.0], 2), ([1.0, 1.0, 1.0], 1)] {
+        let m = cubes(&[[0.0; 3], b], &[1, 2]);
+        let r = check(&m, None);
+        assert!(r.valid, "{b:?}: {r}");
+        assert_eq!(r.n_boundary_faces, 24, "{r}");
+        assert_eq!(r.n_touching_vertices, touching, "{b:?}: {r}");
+        assert!(r.to_string().contains("different regions touch"), "{r}");
+        // With its surface: both cubes' boundaries, each region's own.
+        let mut s = cube_surface([0.0; 3], 1.0);
+        let mut sb = cube_surface(b, 1.0);
+        sb.sides = vec![[2, 0]; 12];
+        s.append(&sb);
+        s.weld_exact();
+        let r = check(&m, Some(&s));
+        assert!(r.valid, "{b:?}: {r}");
+        let sc = r.surface.as_ref().unwrap();
+        let found: Vec<_> = sc
+            .interfaces
+            .iter()
+            .map(|i| (i.labels, i.expected, i.found))
+            .collect();
+        assert_eq!(found, vec![([0, 1], 12, 12), ([0, 2], 12, 12)], "{r}");
+    }
+}
+
+#[test]
+fn a_region_pinched_at_an_edge_or_a_vertex_is_invalid() {
+    // The same cubes as one region: the region is pinched, and the message names the edge or
+    // the vertex by its coordinates.
+    for (b, words) in [
+        (
+            [1.0, 1.0, 0.0],
+            ["non-manifold edges", "(1, 1, 0)–(1, 1, 1) in 4 triangles"],
+        ),
+        (
+            [1.0, 1.0, 1.0],
+            ["non-manifold vertices", "vertex 7 (1, 1, 1)"],
+        ),
+    ] {
+        let m = cubes(&[[0.0; 3], b], &[1, 1]);
+        let r = check(&m, None);
+        assert!(!r.valid, "{b:?}: {r}");
+        let p = r.boundary_problem.as_deref().unwrap();
+        for w in words {
+            assert!(p.contains(w), "{b:?}: {p}");
+        }
+    }
+}
+
+#[test]
+fn touching_is_judged_per_region_not_per_piece() {
+    // A (region 1) and B (region 2) share the face x = 1; C touches B alone along the edge
+    // (2,1,0)-(2,1,1). Region 1 in two pieces (A, C) touching region 2 is fine; C in region 2
+    // pinches region 2 at that edge.
+    let origins = [[0.0; 3], [1.0, 0.0, 0.0], [2.0, 1.0, 0.0]];
+    let r = check(&cubes(&origins, &[1, 2, 1]), None);
+    assert!(r.valid, "{r}");
+    assert_eq!(r.n_touching_vertices, 2, "{r}");
+    let r = check(&cubes(&origins, &[1, 2, 2]), None);
+    assert!(!r.valid, "{r}");
+    let p = r.boundary_problem.as_deref().unwrap();
+    assert!(
+        p.contains("non-manifold edges") && p.contains("(2, 1, 0)–(2, 1, 1)"),
+        "{p}"
+    );
 }

@@ -1,8 +1,8 @@
 //! Several closed surfaces to one labelled surface (nesting, touching, cavities).
 
-use crate::common::{cube_surface, load_stl};
+use crate::common::{cube_points, cube_surface, load_stl};
 use biotet::SurfaceMesh;
-use biotet::mesh::shells::{AssembleError, Part, assemble};
+use biotet::mesh::shells::{AssembleError, Part, assemble, touching};
 use biotet::mesh::validate::{ValidateOptions, validate_surface};
 use biotet::pipeline::{PipelineOptions, mesh_surface};
 use biotet::quality::tet::volume;
@@ -184,4 +184,117 @@ fn a_non_manifold_surface_is_labelled_from_its_cells() {
         (vol[1] - 1.0).abs() < 1e-12 && (vol[2] - 1.0).abs() < 1e-12,
         "{vol:?}"
     );
+}
+
+/// The unit cube at `o` with each face split along the other diagonal than [`cube_surface`].
+fn cube_other_diagonals(o: [f64; 3]) -> SurfaceMesh {
+    let quads = [
+        [2, 3, 1, 0],
+        [5, 7, 6, 4],
+        [1, 5, 4, 0],
+        [6, 7, 3, 2],
+        [4, 6, 2, 0],
+        [3, 7, 5, 1],
+    ];
+    let tris = quads
+        .iter()
+        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+        .collect();
+    SurfaceMesh::closed(cube_points(o, 1.0), tris, 1)
+}
+
+#[test]
+fn shells_touching_along_an_edge_or_at_a_vertex_mesh_as_two_regions() {
+    // One surface of two unit cubes: [1,2]x[1,2]x[0,1] shares the edge (1,1,0)-(1,1,1) with
+    // [0,1]^3; [1,2]^3 shares its vertex (1,1,1).
+    for (b, edge) in [([1.0, 1.0, 0.0], true), ([1.0, 1.0, 1.0], false)] {
+        let mut s = cube_surface([0.0; 3], 1.0);
+        s.append(&cube_other_diagonals(b));
+        s.weld_exact();
+        let (mut s, shells) = assemble(vec![part(s, None)]).unwrap();
+        assert_eq!(shells.len(), 2, "{b:?}");
+        validate_surface(&mut s, &ValidateOptions::default()).unwrap();
+        let at = |p: [f64; 3]| s.points.iter().position(|q| *q == p).unwrap() as u32;
+        let (lo, hi) = (at([1.0, 1.0, 0.0]), at([1.0, 1.0, 1.0]));
+        let t = touching(&s);
+        if edge {
+            assert_eq!(t.edges, vec![([lo.min(hi), lo.max(hi)], vec![1, 2])]);
+            assert!(t.vertices.is_empty(), "{t:?}");
+        } else {
+            assert!(t.edges.is_empty(), "{t:?}");
+            assert_eq!(t.vertices, vec![(hi, vec![1, 2])]);
+        }
+        let sizing = Sizing::uniform(0.4).unwrap();
+        let (mesh, report) =
+            mesh_surface(&s, &sizing, &PipelineOptions::default(), &mut |_| {}).unwrap();
+        assert_eq!(report.recover.as_ref().unwrap().missing_after, 0);
+        let c = biotet::check::check(&mesh, Some(&s));
+        assert!(c.valid, "{b:?}: {c}");
+        assert_eq!(c.n_touching_vertices, if edge { 2 } else { 1 }, "{c}");
+        let found: Vec<_> = c
+            .surface
+            .as_ref()
+            .unwrap()
+            .interfaces
+            .iter()
+            .map(|i| (i.labels, i.expected, i.found))
+            .collect();
+        assert_eq!(found, vec![([0, 1], 12, 12), ([0, 2], 12, 12)], "{c}");
+        assert_eq!(mesh.regions(), vec![1, 2]);
+        // The shared edge (or vertex) is in the mesh, in tets of both regions.
+        let mp = |p: [f64; 3]| mesh.points.iter().position(|q| *q == p).unwrap() as u32;
+        let (lo, hi) = (mp([1.0, 1.0, 0.0]), mp([1.0, 1.0, 1.0]));
+        for label in [1, 2] {
+            assert!(
+                (0..mesh.tets.len()).any(|t| mesh.labels[t] == label
+                    && mesh.tets[t].contains(&hi)
+                    && (!edge || mesh.tets[t].contains(&lo))),
+                "{b:?}: no tet of region {label} at the shared edge or vertex"
+            );
+        }
+        let mut vol = [0.0f64; 3];
+        for t in 0..mesh.tets.len() {
+            vol[mesh.labels[t] as usize] += volume(&mesh.corners(t));
+        }
+        assert!(
+            (vol[1] - 1.0).abs() < 1e-12 && (vol[2] - 1.0).abs() < 1e-12,
+            "{vol:?}"
+        );
+    }
+}
+
+#[test]
+fn one_shell_pinched_at_an_edge_stays_invalid() {
+    // A bow-tie: two tets sharing only the edge (0,0,0)-(0,0,1), given as one region.
+    let pts = vec![
+        [0.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, -1.0, 0.0],
+    ];
+    let mut tris = Vec::new();
+    for tet in [[0u32, 1, 2, 3], [0, 1, 4, 5]] {
+        for k in 0..4 {
+            let f = [tet[(k + 1) % 4], tet[(k + 2) % 4], tet[(k + 3) % 4]];
+            tris.push(f);
+        }
+    }
+    let mut s = SurfaceMesh::closed(pts, tris, 1);
+    let e = validate_surface(&mut s, &ValidateOptions::default()).unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        msg.contains("non-manifold edges") && msg.contains("(0, 0, 0)–(0, 0, 1) in 4 triangles"),
+        "{msg}"
+    );
+    // Given without labels, its two cells are two regions that share the edge.
+    let (mut s, shells) = assemble(vec![part(s, None)]).unwrap();
+    assert_eq!(shells.len(), 2);
+    validate_surface(&mut s, &ValidateOptions::default()).unwrap();
+    assert_eq!(touching(&s).edges, vec![([0, 1], vec![1, 2])]);
+    // Labelled as one region, it is refused again.
+    let (mut one, _) = assemble(vec![part(s, Some(vec![1, 1]))]).unwrap();
+    let e = validate_surface(&mut one, &ValidateOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("(0, 0, 0)–(0, 0, 1)"), "{e}");
 }
