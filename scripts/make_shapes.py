@@ -689,8 +689,8 @@ SHAPES = {
     "gen_disk_top_cube": (gen_disk_top_cube, "make_shapes.py", "generated", "41 cocircular points on a cube's top face"),
     "gen_long_bar_grid": (gen_long_bar_grid, "make_shapes.py", "generated", "100x1x1 bar in unit squares"),
     "gen_cube_rotated": (gen_cube_rotated, "make_shapes.py", "generated", "cube turned 1 rad about (1,√2,√3): inexact planes"),
-    "invalid_two_cubes_edge": (gen_two_cubes_edge, "make_shapes.py", "generated", "two shells touching along an edge"),
-    "invalid_two_cubes_vertex": (gen_two_cubes_vertex, "make_shapes.py", "generated", "two shells touching at a vertex"),
+    "gen_two_cubes_edge": (gen_two_cubes_edge, "make_shapes.py", "generated", "two shells touching along an edge"),
+    "gen_two_cubes_vertex": (gen_two_cubes_vertex, "make_shapes.py", "generated", "two shells touching at a vertex"),
     "gen_two_cubes_apart": (gen_two_cubes_apart, "make_shapes.py", "generated", "two shells 0.001 apart"),
 }
 

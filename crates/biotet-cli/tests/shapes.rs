@@ -2,7 +2,7 @@
 //! `scripts/make_shapes.py`: gmsh/OpenCASCADE CAD solids, trimesh primitives, meshes shipped in
 //! package wheels, generated degenerate cases). Every valid one must mesh with the defaults,
 //! keep every input triangle and pass `biotet check --surface`; the files named `invalid_*` are
-//! refused by `validate`, and `mesh` then writes nothing.
+//! refused by `validate` and `mesh`, which then writes nothing.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -79,16 +79,18 @@ fn every_valid_shape_meshes_with_every_triangle_kept() {
 }
 
 #[test]
-fn invalid_shapes_are_refused_by_validate_naming_the_element() {
+fn invalid_shapes_are_refused_naming_the_element_and_write_nothing() {
     let bad: Vec<PathBuf> = shapes().into_iter().filter(|p| is_invalid(p)).collect();
     assert!(!bad.is_empty());
+    let dir = tempfile::tempdir().unwrap();
     for s in bad {
         let v = biotet(&["validate", s.to_str().unwrap()]);
         let err = String::from_utf8_lossy(&v.stderr);
-        assert!(
-            !v.status.success() || err.contains("touch") || err.contains("shared"),
-            "{}: {err}",
-            s.display()
-        );
+        assert_eq!(v.status.code(), Some(1), "{}: {err}", s.display());
+        assert!(err.contains("edge"), "{}: {err}", s.display());
+        let out = dir.path().join("out.vtu");
+        let m = biotet(&["mesh", s.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+        assert!(!m.status.success(), "{}", s.display());
+        assert!(!out.exists(), "{}: mesh wrote its output", s.display());
     }
 }
