@@ -26,12 +26,17 @@ pub fn failed_path(out: &Path) -> PathBuf {
 }
 
 /// Paths as one comma-separated list for messages.
-pub fn list(paths: &[PathBuf]) -> String {
+pub fn list<P: AsRef<Path>>(paths: &[P]) -> String {
+    joined(paths, ", ")
+}
+
+/// Paths joined by `sep`.
+fn joined<P: AsRef<Path>>(paths: &[P], sep: &str) -> String {
     paths
         .iter()
-        .map(|p| p.display().to_string())
+        .map(|p| p.as_ref().display().to_string())
         .collect::<Vec<_>>()
-        .join(", ")
+        .join(sep)
 }
 
 /// Write a complete result: `main` writes the main output (or nothing) and returns its files,
@@ -79,13 +84,7 @@ pub fn on_failure(
     let not_written = match requested {
         [] => String::new(),
         [one] => format!("{} was not written", one.display()),
-        many => format!(
-            "{} were not written",
-            many.iter()
-                .map(|p| p.display().to_string())
-                .collect::<Vec<_>>()
-                .join(" and ")
-        ),
+        many => format!("{} were not written", joined(many, " and ")),
     };
     let Some(out) = out else {
         return (Vec::new(), not_written);

@@ -1128,28 +1128,34 @@ fn bad_side_labels_name_the_file_and_the_triangle() {
 }
 
 /// A unit cube whose face diagonals admit no tetrahedralization of its eight corners (trimesh's
-/// `creation.box`): meshing it needs a Steiner point inside. No interior node is deployed at the
-/// default size, so `--no-steiner` makes recovery fail.
+/// `creation.box`, from the shape corpus): meshing it needs a Steiner point inside. No interior
+/// node is deployed at the default size, so `--no-steiner` makes recovery fail.
 fn twisted_cube_off() -> String {
-    cube_off(|tris, pts| {
-        *pts = (0..8)
-            .map(|i| [(i >> 2) as f64, ((i >> 1) & 1) as f64, (i & 1) as f64])
-            .collect();
-        *tris = vec![
-            [1, 3, 0],
-            [4, 1, 0],
-            [0, 3, 2],
-            [2, 4, 0],
-            [1, 7, 3],
-            [5, 1, 4],
-            [5, 7, 1],
-            [3, 7, 2],
-            [6, 4, 2],
-            [2, 7, 6],
-            [6, 5, 4],
-            [7, 5, 6],
-        ];
-    })
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/shapes/tm_box.off");
+    std::fs::read_to_string(path).unwrap()
+}
+
+/// The Delaunay tetrahedralization of the twisted cube's corners (`corners.xyz` then `dt.vtu`
+/// in `dir`), the mesh `recover` starts from.
+fn twisted_cube_delaunay(dir: &Path) -> PathBuf {
+    let points = dir.join("corners.xyz");
+    std::fs::write(
+        &points,
+        (0..8)
+            .map(|i| {
+                let c = |b: i32| if b == 0 { "-0.5" } else { "0.5" };
+                format!("{} {} {}\n", c(i >> 2), c((i >> 1) & 1), c(i & 1))
+            })
+            .collect::<String>(),
+    )
+    .unwrap();
+    let dt = dir.join("dt.vtu");
+    assert!(
+        biotet(&["delaunay", s(&points), "-o", s(&dt), "-q"])
+            .status
+            .success()
+    );
+    dt
 }
 
 /// The files in `dir`, sorted.
@@ -1250,20 +1256,7 @@ fn a_failed_recover_creates_and_replaces_nothing_and_keeps_the_partial_mesh_on_r
     let dir = tempfile::tempdir().unwrap();
     let cube = dir.path().join("cube.off");
     std::fs::write(&cube, twisted_cube_off()).unwrap();
-    let points = dir.path().join("corners.xyz");
-    std::fs::write(
-        &points,
-        (0..8)
-            .map(|i| format!("{} {} {}\n", i >> 2, (i >> 1) & 1, i & 1))
-            .collect::<String>(),
-    )
-    .unwrap();
-    let dt = dir.path().join("dt.vtu");
-    assert!(
-        biotet(&["delaunay", s(&points), "-o", s(&dt), "-q"])
-            .status
-            .success()
-    );
+    let dt = twisted_cube_delaunay(dir.path());
     let out = dir.path().join("rec.vtu");
     let failed = dir.path().join("rec.failed.vtu");
     let recover = |extra: &[&str]| {
@@ -1351,20 +1344,7 @@ fn allow_interior_steiner_is_still_accepted_and_the_default() {
     assert!(r.status.success(), "{}", stderr(&r));
     assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
     // recover: the former opt-in gives the default's result.
-    let points = dir.path().join("corners.xyz");
-    std::fs::write(
-        &points,
-        (0..8)
-            .map(|i| format!("{} {} {}\n", i >> 2, (i >> 1) & 1, i & 1))
-            .collect::<String>(),
-    )
-    .unwrap();
-    let dt = dir.path().join("dt.vtu");
-    assert!(
-        biotet(&["delaunay", s(&points), "-o", s(&dt), "-q"])
-            .status
-            .success()
-    );
+    let dt = twisted_cube_delaunay(dir.path());
     let mut results = Vec::new();
     for extra in [&[][..], &["--allow-interior-steiner"]] {
         let rec = dir.path().join(format!("rec{}.vtu", results.len()));

@@ -78,14 +78,14 @@ pub(crate) fn kernel_point(points: &[P3], faces: &[[u32; 3]]) -> Option<P3> {
             return Some(add(x, centre));
         }
         // The planes nearly tied for the smallest distance, nearest first.
-        let tol = 1e-9 * step.max(fx.abs());
+        let tol = 1e-3 * step;
         active.clear();
         active.extend(
             planes
                 .iter()
                 .enumerate()
                 .map(|(i, &(u, d))| (dot(u, x) - d, i))
-                .filter(|&(v, _)| v <= fx + tol.max(1e-3 * step)),
+                .filter(|&(v, _)| v <= fx + tol),
         );
         active.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         grads.clear();

@@ -121,22 +121,14 @@ pub struct RecoverOptions {
 /// cavity of the corners, whose search is better conditioned).
 const CROSSED_MAX_TETS: usize = 64;
 
-/// Largest cavity of the Steiner fallback (see [`RecoverOptions::max_cavity_tets`]).
-const STEINER_MAX_TETS: usize = 300;
-
-/// Rings and largest cavity of the Steiner fallback once a round with the small ones made no
-/// progress (a surface triangle far larger than the interior spacing needs a wide cavity).
-const STEINER_GROW_WIDE: u32 = 6;
-const STEINER_MAX_TETS_WIDE: usize = 2000;
-/// The no-new-point queue's largest cavity and node budget in the wide rounds.
-const WIDE_MAX_TETS: usize = 1500;
+/// The bounds of the rounds after a Steiner round without progress (a surface triangle far
+/// larger than the interior spacing needs a wide cavity): rings, cavity tets, search nodes.
+const WIDE_GROW: u32 = 6;
+const WIDE_MAX_TETS: usize = 2000;
 const WIDE_NODES: u64 = 2000;
 
 /// Rounds of the Steiner fallback, each followed by the no-new-point queue.
 const STEINER_ROUNDS: usize = 8;
-
-/// Growth rings of the Steiner fallback's cavities (see [`RecoverOptions::max_grow`]).
-const STEINER_GROW: u32 = 2;
 
 /// Node budget of the first, higher-threshold try.
 const FIRST_TRY_NODES: u64 = 500;
@@ -295,32 +287,24 @@ fn recover_checked(
 ) -> Result<RecoverReport, RecoverError> {
     let tets_before = mesh.tets.len();
     // Surface corners → mesh points.
-    let mut at: FxHashMap<[u64; 3], u32> = FxHashMap::default();
-    at.reserve(mesh.points.len());
-    for (i, p) in mesh.points.iter().enumerate() {
-        at.entry(coord_key(p)).or_insert(i as u32);
-    }
-    let tri_map = map_triangles(surface, &at);
-    drop(at);
-
+    // (The index is dropped before the recovery's arrays are built: it would set the peak.)
+    let tri_map = map_triangles(surface, &point_index(&mesh.points));
     let mut r = Recovery::new(mesh, surface, tri_map, *opts);
     r.scan_present();
     let missing_before = r.count_missing();
     let domain = r.cover()?;
     // Surface points the mesh lacks (or holds in no tet: a mesh whose outside tets were
     // removed drops them) are the surface's own points, not new ones: put them back first.
-    let absent = r.absent_surface_points();
-    let (mut r, reinserted) = if absent.is_empty() {
+    let (mut r, reinserted) = if r.corners_live() {
         (r, 0)
     } else {
+        let mut at = point_index(&r.mesh.points);
+        let absent = r.absent_surface_points(&at);
         drop(r);
-        let n = insert_points(mesh, &absent)?;
-        let mut at: FxHashMap<[u64; 3], u32> = FxHashMap::default();
-        for (i, p) in mesh.points.iter().enumerate() {
-            at.entry(coord_key(p)).or_insert(i as u32);
-        }
+        insert_points(mesh, &absent, &mut at)?;
         let tri_map = map_triangles(surface, &at);
-        (Recovery::new(mesh, surface, tri_map, *opts), n)
+        drop(at);
+        (Recovery::new(mesh, surface, tri_map, *opts), absent.len())
     };
     if domain != Domain::Convex || reinserted > 0 {
         // Tets put back may hold surface triangles.
@@ -351,23 +335,11 @@ fn recover_checked(
     // Also sets the final `is_present`.
     let (removed, conflicts) = r.relabel();
 
-    // The faces of the output, to confirm `is_present` in debug builds. (Not the star walk of
-    // `present`: with the outside removed, regions touching only at a vertex or an edge leave
-    // that vertex's star in pieces that share no face.)
-    #[cfg(debug_assertions)]
-    let faces: rustc_hash::FxHashSet<[u32; 3]> = r
-        .mesh
-        .tets
-        .iter()
-        .flat_map(|v| TET_FACES.map(|l| sorted3([v[l[0]], v[l[1]], v[l[2]]])))
-        .collect();
+    if cfg!(debug_assertions) {
+        r.assert_present();
+    }
     let mut unrecovered = Vec::new();
-    for (s, m) in r.tri_map.iter().enumerate() {
-        #[cfg(debug_assertions)]
-        debug_assert_eq!(
-            r.is_present[s],
-            m.is_some_and(|v| faces.contains(&sorted3(v)))
-        );
+    for s in 0..r.tri_map.len() {
         if !r.is_present[s] {
             let corners = surface.corners(s);
             unrecovered.push(Unrecovered {
@@ -415,6 +387,16 @@ fn recover_checked(
     Ok(report)
 }
 
+/// Mesh point numbers by exact coordinates (the first of equal points).
+fn point_index(points: &[P3]) -> FxHashMap<[u64; 3], u32> {
+    let mut at: FxHashMap<[u64; 3], u32> = FxHashMap::default();
+    at.reserve(points.len());
+    for (i, p) in points.iter().enumerate() {
+        at.entry(coord_key(p)).or_insert(i as u32);
+    }
+    at
+}
+
 /// Surface triangles in mesh point numbers, by exact coordinates (`None`: a corner is no mesh
 /// point).
 fn map_triangles(surface: &SurfaceMesh, at: &FxHashMap<[u64; 3], u32>) -> Vec<Option<[u32; 3]>> {
@@ -432,14 +414,15 @@ fn map_triangles(surface: &SurfaceMesh, at: &FxHashMap<[u64; 3], u32>) -> Vec<Op
 }
 
 /// Put each point of `pts` into `mesh` (appended unless a mesh point has its coordinates) by
-/// splitting every tet whose closure holds it (exact, [`split_insert`]); the adjacency is
-/// rebuilt once at the end. Returns how many were put in; a point outside every tet is an
-/// error (the mesh does not cover the surface).
-fn insert_points(mesh: &mut TetMesh, pts: &[P3]) -> Result<usize, RecoverError> {
-    let mut at: FxHashMap<[u64; 3], u32> = FxHashMap::default();
-    for (i, p) in mesh.points.iter().enumerate() {
-        at.entry(coord_key(p)).or_insert(i as u32);
-    }
+/// splitting every tet whose closure holds it (exact, [`split_insert`]), or outside the mesh
+/// by growing its hull ([`extend_hull`]); `at` ([`point_index`]) gains the appended points
+/// and the adjacency is rebuilt once at the end. A point outside every tet that no boundary
+/// face sees is an error (the mesh does not cover the surface).
+fn insert_points(
+    mesh: &mut TetMesh,
+    pts: &[P3],
+    at: &mut FxHashMap<[u64; 3], u32>,
+) -> Result<(), RecoverError> {
     let mut holding = Vec::new();
     let mut local = Vec::new();
     for &p in pts {
@@ -490,7 +473,7 @@ fn insert_points(mesh: &mut TetMesh, pts: &[P3]) -> Result<usize, RecoverError> 
         }
     }
     mesh.rebuild_neighbors();
-    Ok(pts.len())
+    Ok(())
 }
 
 /// Add the tets from point `x` to every mesh boundary face that sees it strictly from outside
@@ -797,6 +780,8 @@ enum Failure {
     Cells,
     /// A cell with no fill of its points has no point strictly inside its kernel.
     NoKernel,
+    /// The kernel point found lies on a surface triangle that crosses the cavity.
+    OnSurface,
     Search(SearchError),
 }
 
@@ -808,6 +793,9 @@ impl Failure {
             Failure::Cells => "the cavity's constrained faces do not split it into cells".into(),
             Failure::NoKernel => "no fill exists without new points, and no cell of the cavity \
                                   is star-shaped for one interior point"
+                .into(),
+            Failure::OnSurface => "the only interior point found lies on another surface \
+                                   triangle"
                 .into(),
             Failure::Search(SearchError::NoFill { .. }) => {
                 "no fill of the cavity exists without new points (search exhausted)".into()
@@ -1681,7 +1669,7 @@ impl<'a> Recovery<'a> {
                     }
                     Some(_) => wait.push(s),
                     None => {
-                        if self.attempt(s, v, None) {
+                        if self.attempt(s, v, false) {
                             stalled = 0;
                             self.reason.remove(&s);
                         } else {
@@ -1717,10 +1705,9 @@ impl<'a> Recovery<'a> {
 
     /// One triangle: first the smallest cavity (the tets it crosses), then the cavity of its
     /// corners, grown on failure.
-    fn attempt(&mut self, s: u32, v: [u32; 3], steiner: Option<()>) -> bool {
-        // With Steiner points, the small cavities first too: a cell of few faces is more
-        // likely star-shaped, and its cone is small.
-        let kernel = steiner.is_some();
+    /// With `kernel` (the Steiner fallback), the small cavities come first too: a cell of few
+    /// faces is more likely star-shaped, and its cone is small.
+    fn attempt(&mut self, s: u32, v: [u32; 3], kernel: bool) -> bool {
         if let Some(crossed) = self.with_work(|view, w| view.crossed_tets(w, v)) {
             self.crossed_tried += 1;
             if self.carve_and_fill(v, &crossed, kernel).is_ok() {
@@ -1750,32 +1737,16 @@ impl<'a> Recovery<'a> {
             }
             tets
         });
-        // The fallback may need a wider cavity to find a star-shaped cell; it runs once per
-        // triangle, so it gets more rings than the no-new-point search.
-        let rings = if kernel && self.wide {
-            self.opts.max_grow.max(STEINER_GROW_WIDE)
-        } else if kernel {
-            self.opts.max_grow.max(STEINER_GROW)
-        } else {
-            self.opts.max_grow
-        };
-        for ring in 0..=rings {
+        for ring in 0..=self.opts.max_grow {
             if ring > 0 {
                 self.grown += 1;
                 self.with_work(|view, w| view.grow(w, &mut tets));
             }
-            let cap = if kernel && self.wide {
-                self.opts.max_cavity_tets.max(STEINER_MAX_TETS_WIDE)
-            } else if kernel {
-                self.opts.max_cavity_tets.max(STEINER_MAX_TETS)
-            } else {
-                self.opts.max_cavity_tets
-            };
-            if tets.len() > cap {
+            if tets.len() > self.opts.max_cavity_tets {
                 self.reason.insert(s, Failure::TooLarge.describe());
                 break;
             }
-            match self.carve_and_fill(v, &tets, steiner.is_some()) {
+            match self.carve_and_fill(v, &tets, kernel) {
                 Ok(()) => return true,
                 Err(f) => {
                     self.reason.insert(s, f.describe());
@@ -1924,7 +1895,7 @@ impl<'a> Recovery<'a> {
             return Ok(new_tets);
         }
         if pending.iter().any(|&x| self.on_surface(cav.coords[x])) {
-            return Err(Failure::NoKernel);
+            return Err(Failure::OnSurface);
         }
         for x in pending {
             let id = self.mesh.points.len() as u32;
@@ -1959,46 +1930,57 @@ impl<'a> Recovery<'a> {
         })
     }
 
-    /// Switch to the wide bounds for the rounds left (see [`STEINER_GROW_WIDE`]).
+    /// Switch to the wide bounds for the rounds left (see [`WIDE_GROW`]).
     fn widen(&mut self) {
         self.wide = true;
-        self.opts.max_grow = self.opts.max_grow.max(STEINER_GROW_WIDE);
+        self.opts.max_grow = self.opts.max_grow.max(WIDE_GROW);
         self.opts.max_cavity_tets = self.opts.max_cavity_tets.max(WIDE_MAX_TETS);
         self.opts.search.max_nodes = self.opts.search.max_nodes.max(WIDE_NODES);
     }
 
-    /// Coordinates of the surface points (once each) that are no mesh point or a mesh point in
-    /// no live tet.
-    fn absent_surface_points(&self) -> Vec<P3> {
+    /// Debug check: `is_present` is what the output's faces say. (Not a star walk: with the
+    /// outside removed, regions touching only at a vertex or an edge leave that vertex's star
+    /// in pieces that share no face.)
+    fn assert_present(&self) {
+        let faces: FxHashSet<[u32; 3]> = self
+            .mesh
+            .tets
+            .iter()
+            .flat_map(|v| TET_FACES.map(|l| sorted3([v[l[0]], v[l[1]], v[l[2]]])))
+            .collect();
+        for (s, m) in self.tri_map.iter().enumerate() {
+            assert_eq!(
+                self.is_present[s],
+                m.is_some_and(|v| faces.contains(&sorted3(v))),
+                "surface triangle {s}"
+            );
+        }
+    }
+
+    /// Whether every surface triangle's corners are mesh points in live tets (as in the
+    /// pipeline), so no point needs putting back.
+    fn corners_live(&self) -> bool {
+        self.tri_map
+            .iter()
+            .all(|m| m.is_some_and(|v| v.iter().all(|&x| self.vtet[x as usize] != NO_NEIGHBOR)))
+    }
+
+    /// Coordinates of the triangles' corners (once each) that are no mesh point or a mesh
+    /// point in no live tet (`at`: [`point_index`] of the mesh).
+    fn absent_surface_points(&self, at: &FxHashMap<[u64; 3], u32>) -> Vec<P3> {
         let mut seen: FxHashSet<[u64; 3]> = FxHashSet::default();
         let mut out = Vec::new();
-        for (s, m) in self.tri_map.iter().enumerate() {
-            let corners = self.surface.triangles[s];
-            for (k, &c) in corners.iter().enumerate() {
-                let lacks = match m {
-                    Some(v) => self.vtet[v[k] as usize] == NO_NEIGHBOR,
-                    None => true,
-                };
-                let p = self.surface.points[c as usize];
-                if lacks && seen.insert(coord_key(&p)) {
-                    // Mapped corners of a partly mapped triangle are checked by `vtet`.
-                    if m.is_none() && self.has_live_point(p) {
-                        continue;
-                    }
-                    out.push(p);
-                }
+        for &c in self.surface.triangles.iter().flatten() {
+            let p = self.surface.points[c as usize];
+            let key = coord_key(&p);
+            let lacks = at
+                .get(&key)
+                .is_none_or(|&i| self.vtet[i as usize] == NO_NEIGHBOR);
+            if lacks && seen.insert(key) {
+                out.push(p);
             }
         }
         out
-    }
-
-    /// Whether a mesh point in a live tet has the coordinates `p`.
-    fn has_live_point(&self, p: P3) -> bool {
-        self.mesh
-            .points
-            .iter()
-            .enumerate()
-            .any(|(i, q)| *q == p && self.vtet[i] != NO_NEIGHBOR)
     }
 
     /// Last resort: the failed triangles again, each cavity with one interior point.
@@ -2012,7 +1994,7 @@ impl<'a> Recovery<'a> {
                 continue;
             }
             let n0 = self.mesh.points.len();
-            if self.attempt(s, v, Some(())) {
+            if self.attempt(s, v, true) {
                 self.steiner_points += self.mesh.points.len() - n0;
                 self.reason.remove(&s);
             }

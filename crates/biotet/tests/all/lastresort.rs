@@ -583,11 +583,7 @@ fn recover_fails_honestly_on_schoenhardt() {
     let (p, f) = twisted_prism(30.0, false);
     let s = surface_of(&p, &f);
     let mut m = Delaunay::new(&p).unwrap().to_tet_mesh();
-    let no = RecoverOptions {
-        allow_interior_steiner: false,
-        ..RecoverOptions::default()
-    };
-    let r = recover(&mut m, &s, &no).unwrap();
+    let r = recover(&mut m, &s, &no_steiner()).unwrap();
     assert!(!r.is_complete());
     assert_eq!(r.missing_after, r.unrecovered.len());
     assert!(r.missing_before >= 3);
@@ -734,6 +730,14 @@ fn recover_puts_back_surface_points_the_mesh_dropped() {
     assert!((v - v0).abs() < 1e-9 * v0, "volume {v} vs {v0}");
 }
 
+/// The seed's method alone: no new point.
+fn no_steiner() -> RecoverOptions {
+    RecoverOptions {
+        allow_interior_steiner: false,
+        ..RecoverOptions::default()
+    }
+}
+
 /// trimesh's `creation.box` face list: its face diagonals admit no tetrahedralization of the
 /// eight corners, so one interior point is needed.
 fn twisted_cube() -> SurfaceMesh {
@@ -770,11 +774,7 @@ fn a_cube_whose_diagonals_twist_gets_one_interior_point() {
     let p = s.points.clone();
     // Without new points the seed's method cannot finish ...
     let mut m = Delaunay::new(&p).unwrap().to_tet_mesh();
-    let no = RecoverOptions {
-        allow_interior_steiner: false,
-        ..RecoverOptions::default()
-    };
-    let r = recover(&mut m, &s, &no).unwrap();
+    let r = recover(&mut m, &s, &no_steiner()).unwrap();
     assert!(!r.is_complete());
     // ... with the fallback (the default) one point strictly inside, never on the surface.
     let mut m = Delaunay::new(&p).unwrap().to_tet_mesh();

@@ -1,6 +1,6 @@
 //! Several closed surfaces to one labelled surface (nesting, touching, cavities).
 
-use crate::common::{cube_points, cube_surface, load_stl};
+use crate::common::{cube_surface, load_stl};
 use biotet::SurfaceMesh;
 use biotet::mesh::shells::{AssembleError, Part, assemble, touching};
 use biotet::mesh::validate::{ValidateOptions, validate_surface};
@@ -88,10 +88,7 @@ fn nested_brain_and_white_matter_mesh_into_two_regions() {
     .unwrap();
     let (mesh, _) =
         mesh_surface(&s, &sizing, &PipelineOptions::deploy_only(), &mut |_| {}).unwrap();
-    let mut vol = [0.0f64; 3];
-    for t in 0..mesh.tets.len() {
-        vol[mesh.labels[t] as usize] += volume(&mesh.corners(t));
-    }
+    let vol = region_volumes(&mesh);
     // Region 2 is the white matter (552,267 mm³), region 1 the rest of the brain (1,659,213 −
     // 552,267); before boundary recovery the split follows the centroids, within 3%.
     assert_eq!(vol[0], 0.0);
@@ -176,31 +173,20 @@ fn a_non_manifold_surface_is_labelled_from_its_cells() {
     let (mesh, _) = mesh_surface(&s, &sizing, &PipelineOptions::default(), &mut |_| {}).unwrap();
     let c = biotet::check::check(&mesh, Some(&s));
     assert!(c.valid, "{c}");
-    let mut vol = [0.0f64; 3];
-    for t in 0..mesh.tets.len() {
-        vol[mesh.labels[t] as usize] += volume(&mesh.corners(t));
-    }
+    let vol = region_volumes(&mesh);
     assert!(
         (vol[1] - 1.0).abs() < 1e-12 && (vol[2] - 1.0).abs() < 1e-12,
         "{vol:?}"
     );
 }
 
-/// The unit cube at `o` with each face split along the other diagonal than [`cube_surface`].
-fn cube_other_diagonals(o: [f64; 3]) -> SurfaceMesh {
-    let quads = [
-        [2, 3, 1, 0],
-        [5, 7, 6, 4],
-        [1, 5, 4, 0],
-        [6, 7, 3, 2],
-        [4, 6, 2, 0],
-        [3, 7, 5, 1],
-    ];
-    let tris = quads
-        .iter()
-        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
-        .collect();
-    SurfaceMesh::closed(cube_points(o, 1.0), tris, 1)
+/// Volume of each region (by label) of `mesh`.
+fn region_volumes(mesh: &biotet::TetMesh) -> [f64; 3] {
+    let mut vol = [0.0f64; 3];
+    for t in 0..mesh.tets.len() {
+        vol[mesh.labels[t] as usize] += volume(&mesh.corners(t));
+    }
+    vol
 }
 
 #[test]
@@ -209,7 +195,7 @@ fn shells_touching_along_an_edge_or_at_a_vertex_mesh_as_two_regions() {
     // [0,1]^3; [1,2]^3 shares its vertex (1,1,1).
     for (b, edge) in [([1.0, 1.0, 0.0], true), ([1.0, 1.0, 1.0], false)] {
         let mut s = cube_surface([0.0; 3], 1.0);
-        s.append(&cube_other_diagonals(b));
+        s.append(&cube_surface(b, 1.0));
         s.weld_exact();
         let (mut s, shells) = assemble(vec![part(s, None)]).unwrap();
         assert_eq!(shells.len(), 2, "{b:?}");
@@ -252,10 +238,7 @@ fn shells_touching_along_an_edge_or_at_a_vertex_mesh_as_two_regions() {
                 "{b:?}: no tet of region {label} at the shared edge or vertex"
             );
         }
-        let mut vol = [0.0f64; 3];
-        for t in 0..mesh.tets.len() {
-            vol[mesh.labels[t] as usize] += volume(&mesh.corners(t));
-        }
+        let vol = region_volumes(&mesh);
         assert!(
             (vol[1] - 1.0).abs() < 1e-12 && (vol[2] - 1.0).abs() < 1e-12,
             "{vol:?}"
