@@ -264,3 +264,58 @@ fn pipeline_on_the_brain_keeps_the_inside() {
     let enclosed = 1_659_213.0;
     assert!((v - enclosed).abs() / enclosed < 0.02, "volume {v}");
 }
+
+/// The smallest sphere through a triangle's corners (centre in its plane), and its radius.
+fn circumsphere(p: [[f64; 3]; 3]) -> ([f64; 3], f64) {
+    use biotet::geom::vec3::{add, cross, dot, norm, scale, sub};
+    let (a, b) = (sub(p[1], p[0]), sub(p[2], p[0]));
+    let n = cross(a, b);
+    let r = scale(
+        add(scale(cross(b, n), dot(a, a)), scale(cross(n, a), dot(b, b))),
+        0.5 / dot(n, n),
+    );
+    (add(p[0], r), norm(r))
+}
+
+#[test]
+fn size_finer_than_the_surface_keeps_nodes_out_of_triangle_circumspheres() {
+    // Triangles of edge about 3.9 at size 1: each is sealed, and no interior node may sit in
+    // its smallest circumsphere (else the triangle is not Delaunay and recovery must dig). A
+    // node set outside every such sphere still fills the ball (the spheres reach only about
+    // 2.3 inward).
+    let s = SurfaceMesh::icosphere(10.0, 2);
+    let d = deploy(
+        &s,
+        &Sizing::uniform(1.0).unwrap(),
+        &DeployOptions::default(),
+    )
+    .unwrap();
+    assert!(
+        d.stats.sealed_triangles == s.triangles.len(),
+        "{:?}",
+        d.stats
+    );
+    assert!(d.stats.interior_nodes > 1000, "{:?}", d.stats);
+    for t in 0..s.triangles.len() {
+        let (c, r) = circumsphere(s.corners(t));
+        for p in &d.points[d.n_surface..] {
+            let dist = biotet::geom::vec3::norm(biotet::geom::vec3::sub(*p, c));
+            assert!(
+                dist >= r,
+                "node {p:?} inside the circumsphere of triangle {t}"
+            );
+        }
+    }
+    // So the Delaunay tetrahedralization already has every triangle, and the pipeline's mesh is
+    // valid with no Steiner point.
+    let sizing = Sizing::uniform(1.0).unwrap();
+    let (_, before) =
+        mesh_surface(&s, &sizing, &PipelineOptions::deploy_only(), &mut |_| {}).unwrap();
+    let (mesh, report) =
+        mesh_surface(&s, &sizing, &PipelineOptions::default(), &mut |_| {}).unwrap();
+    eprintln!("missing before recovery: {}", before.missing_triangles);
+    assert_eq!(before.missing_triangles, 0);
+    let c = check(&mesh, Some(&s));
+    assert!(c.valid, "{:?}", c.problems);
+    assert_eq!(report.recover.as_ref().unwrap().steiner_points, 0);
+}
