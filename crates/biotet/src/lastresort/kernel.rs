@@ -11,11 +11,13 @@
 //! The point is searched in floating point (maximise the smallest distance to the face planes,
 //! the Chebyshev centre of the kernel, by min-norm ascent, the direction smoothing uses), then
 //! decided exactly: it is returned only if `orient3d` puts it strictly on the inner side of
-//! every face. A cell whose kernel is empty, or so thin that the ascent misses it, gives `None`.
+//! every face. Of the first such point on the way and the deepest, the one whose cone has fewer
+//! tets under 10° (then the larger smallest dihedral angle) is returned. A cell whose kernel is empty, or so thin that the ascent misses it, gives `None`.
 
 use crate::geom::filter::orient3d;
 use crate::geom::predicates::{Sign, in_exact_range};
 use crate::geom::vec3::{add, cross, dot, norm2, scale, sub};
+use crate::quality::tet::min_dihedral_deg;
 use crate::smooth::ascent::{MAX_ACTIVE, min_norm_point};
 
 type P3 = [f64; 3];
@@ -73,9 +75,15 @@ pub(crate) fn kernel_point(points: &[P3], faces: &[[u32; 3]]) -> Option<P3> {
     let mut step = diameter2.sqrt().max(f64::MIN_POSITIVE);
     let mut active: Vec<(f64, usize)> = Vec::with_capacity(planes.len());
     let mut grads: Vec<P3> = Vec::with_capacity(MAX_ACTIVE);
+    // Two candidates: the first exactly inside point on the way and the deepest one (the last
+    // exactly inside). Neither is always better: the deeper point keeps away from every face,
+    // the first one stays nearer the cell's centroid.
+    let mut first: Option<P3> = None;
+    let mut last: Option<P3> = None;
     for _ in 0..MAX_STEPS {
         if fx > 0.0 && exact_ok(x) {
-            return Some(add(x, centre));
+            first.get_or_insert(x);
+            last = Some(x);
         }
         // The planes nearly tied for the smallest distance, nearest first.
         let tol = 1e-3 * step;
@@ -116,7 +124,31 @@ pub(crate) fn kernel_point(points: &[P3], faces: &[[u32; 3]]) -> Option<P3> {
             break;
         }
     }
-    (fx > 0.0 && exact_ok(x)).then(|| add(x, centre))
+    if fx > 0.0 && exact_ok(x) {
+        first.get_or_insert(x);
+        last = Some(x);
+    }
+    // Score: the cone's tets under 10°, then its smallest dihedral angle.
+    let score = |x: P3| {
+        let p = add(x, centre);
+        faces.iter().fold((0usize, f64::INFINITY), |(n, m), f| {
+            let [a, b, c] = f.map(|i| points[i as usize]);
+            let d = min_dihedral_deg(&[a, b, c, p]);
+            (n + usize::from(d < 10.0), m.min(d))
+        })
+    };
+    let best = match (first, last) {
+        (Some(a), Some(b)) => {
+            let (sa, sb) = (score(a), score(b));
+            if sb.0 < sa.0 || (sb.0 == sa.0 && sb.1 > sa.1) {
+                b
+            } else {
+                a
+            }
+        }
+        _ => return None,
+    };
+    Some(add(best, centre))
 }
 
 /// The cone from point `p` (index `apex`) over `faces`: one positively oriented tet per face
