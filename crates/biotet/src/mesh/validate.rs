@@ -628,6 +628,39 @@ pub enum SurfaceError {
     },
 }
 
+impl SurfaceError {
+    /// The indices of the offending triangles the error lists (its first examples, in order,
+    /// without repeats; empty when it names points or no element).
+    pub fn triangles(&self) -> Vec<u32> {
+        use SurfaceError::*;
+        let mut out: Vec<u32> = match self {
+            Empty | TooLarge(_) | SidesLength { .. } | NonFinite { .. } => Vec::new(),
+            IndexOutOfRange { first, .. } => first.iter().map(|(t, _)| *t).collect(),
+            SameRegionBothSides { first, .. } => first.iter().map(|(t, _)| *t).collect(),
+            Degenerate { first, .. } | Flipped { first, .. } | NonOrientable { first, .. } => {
+                first.iter().map(|t| t.index).collect()
+            }
+            Duplicate { first, .. } | SelfIntersection { first, .. } => {
+                first.iter().flat_map(|p| [p.0.index, p.1.index]).collect()
+            }
+            NotClosed { first, .. } | NonManifoldEdge { first, .. } => first
+                .iter()
+                .flat_map(|e| e.triangles.iter().map(|t| t.index))
+                .collect(),
+            NonManifoldVertex { first, .. } => first
+                .iter()
+                .flat_map(|v| v.triangles.iter().copied())
+                .collect(),
+            Inward { first, .. } | LabelsContradictGeometry { first, .. } => {
+                first.iter().map(|s| s.triangle.index).collect()
+            }
+        };
+        let mut seen = rustc_hash::FxHashSet::default();
+        out.retain(|t| seen.insert(*t));
+        out
+    }
+}
+
 // -------------------------------------------------------------------------------------------
 // Small helpers
 // -------------------------------------------------------------------------------------------

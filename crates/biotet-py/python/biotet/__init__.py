@@ -1,0 +1,440 @@
+"""biotet: tetrahedral meshes of anatomy from closed triangulated surfaces.
+
+Every input triangle is kept exactly, interior nodes are deployed on a template, boundary
+recovery and sliver removal use the LAST RESORT search, and solid-angle smoothing finishes the
+mesh. numpy arrays go in and out; the GIL is released while biotet computes, so threads and Dask
+workers mesh in parallel.
+
+>>> import biotet, numpy as np
+>>> m = biotet.mesh_file("brain.stl")                    # doctest: +SKIP
+>>> m.points.shape, m.tets.shape, m.report["quality"]["min_dihedral_deg"]  # doctest: +SKIP
+
+Functions mirror the command-line tool: :func:`mesh`, :func:`mesh_file`, :func:`recover`,
+:func:`improve`, :func:`smooth`, :func:`check`, :func:`quality`, :func:`delaunay`,
+:func:`read`, :func:`write`. Errors are :class:`InvalidSurfaceError` (a ``ValueError``),
+:class:`MeshingError`, and ``OSError`` subclasses for files. Progress goes to the ``biotet``
+logger (level INFO) or to a ``progress`` callable.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+from dataclasses import dataclass, field
+from typing import Any, Callable, Iterable, Mapping, Sequence, Union
+
+import numpy as np
+
+from . import _core
+
+__all__ = [
+    "TetMesh",
+    "Surface",
+    "BiotetError",
+    "InvalidSurfaceError",
+    "MeshingError",
+    "BiotetFileError",
+    "mesh",
+    "mesh_file",
+    "recover",
+    "improve",
+    "smooth",
+    "check",
+    "quality",
+    "delaunay",
+    "read",
+    "read_surface",
+    "write",
+    "__version__",
+]
+
+__version__: str = _core.__version__
+
+logger = logging.getLogger("biotet")
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+
+class BiotetError(Exception):
+    """Base class of biotet's errors. ``triangles`` lists the offending input triangles (their
+    indices in the given arrays or file) when the error names any."""
+
+    def __init__(self, message: str, triangles: Sequence[int] = ()):
+        super().__init__(message)
+        self.triangles: list[int] = list(triangles)
+
+
+class InvalidSurfaceError(BiotetError, ValueError):
+    """The surface is not a valid closed surface (open, non-manifold, self-intersecting,
+    degenerate, inconsistently oriented...): the message says which triangles and why, as
+    ``biotet validate`` does."""
+
+
+class MeshingError(BiotetError, RuntimeError):
+    """Meshing could not finish on a valid input (or an internal error was caught)."""
+
+
+class BiotetFileError(BiotetError, OSError):
+    """A file could not be read or written: malformed, truncated, unknown format."""
+
+
+class _NotFound(BiotetFileError, FileNotFoundError):
+    pass
+
+
+class _Permission(BiotetFileError, PermissionError):
+    pass
+
+
+_KINDS: dict[str, type[BiotetError]] = {
+    "invalid_surface": InvalidSurfaceError,
+    "meshing": MeshingError,
+    "panic": MeshingError,
+    "not_found": _NotFound,
+    "permission": _Permission,
+    "file": BiotetFileError,
+}
+
+
+def _call(fn: Callable[..., Any], *args: Any, **kwargs: Any) -> Any:
+    """Call into the native module, turning its errors into biotet's exception classes."""
+    try:
+        return fn(*args, **kwargs)
+    except _core.CoreError as e:
+        kind, message, triangles = e.args
+        if kind == "value":
+            raise ValueError(message) from None
+        raise _KINDS.get(kind, MeshingError)(message, triangles) from None
+
+
+def _progress(progress: Callable[[str], Any] | None) -> Callable[[str], Any] | None:
+    if progress is not None:
+        return progress
+    if logger.isEnabledFor(logging.INFO):
+        return lambda stage: logger.info("%s", stage)
+    return None
+
+
+def _points(a: Any, what: str = "points") -> np.ndarray:
+    p = np.ascontiguousarray(a, dtype=np.float64)
+    if p.ndim != 2 or p.shape[1] != 3:
+        raise ValueError(f"{what} must have shape (n, 3), not {p.shape}")
+    return p
+
+
+def _indices(a: Any, width: int, what: str) -> np.ndarray:
+    x = np.asarray(a)
+    if x.size and not np.issubdtype(x.dtype, np.integer):
+        raise ValueError(f"{what} must hold integers, not {x.dtype}")
+    x = np.ascontiguousarray(x, dtype=np.int64)
+    if x.ndim != 2 or x.shape[1] != width:
+        raise ValueError(f"{what} must have shape (n, {width}), not {x.shape}")
+    return x
+
+
+def _labels(a: Any, n: int) -> np.ndarray:
+    x = np.ascontiguousarray(a, dtype=np.int64).reshape(-1)
+    if x.shape[0] != n:
+        raise ValueError(f"labels has {x.shape[0]} entries for {n} tets")
+    return x
+
+
+@dataclass
+class Surface:
+    """A triangle surface: ``points`` (n×3 float64), ``triangles`` (m×3 int32) and ``sides``
+    (m×2 int32: the region behind and in front of each triangle, ``[1, 0]`` for a plain closed
+    surface)."""
+
+    points: np.ndarray
+    triangles: np.ndarray
+    sides: np.ndarray
+
+
+@dataclass
+class TetMesh:
+    """A tetrahedral mesh: ``points`` (n×3 float64), ``tets`` (m×4 int32, positively oriented),
+    ``labels`` (m int32, the region of each tet) and ``report`` (the dict ``biotet mesh --json``
+    prints: pipeline stages, quality, forcing; empty for meshes read from files)."""
+
+    points: np.ndarray
+    tets: np.ndarray
+    labels: np.ndarray
+    report: dict = field(default_factory=dict)
+
+    @property
+    def n_points(self) -> int:
+        """Number of points."""
+        return int(self.points.shape[0])
+
+    @property
+    def n_tets(self) -> int:
+        """Number of tets."""
+        return int(self.tets.shape[0])
+
+    def write(self, path: PathLike) -> list[str]:
+        """Write the mesh (format from the extension: .vtu, .mesh, .msh, .node/.ele); the file
+        appears whole or not at all. Returns the paths written."""
+        return write(path, self)
+
+    def check(self, surface: Surface | tuple[Any, Any] | None = None,
+              labels: Sequence[int] | None = None) -> dict:
+        """The validity report of :func:`check`."""
+        return check(self, surface, labels=labels)
+
+    def quality(self) -> dict:
+        """The quality report of :func:`quality`."""
+        return quality(self)
+
+    def to_meshio(self) -> Any:
+        """A ``meshio.Mesh`` with the labels as cell data ``"region"`` (needs meshio)."""
+        try:
+            import meshio
+        except ImportError as e:
+            raise ImportError("to_meshio needs meshio: pip install meshio") from e
+        return meshio.Mesh(
+            self.points, [("tetra", self.tets)], cell_data={"region": [self.labels]}
+        )
+
+    def to_pyvista(self) -> Any:
+        """A ``pyvista.UnstructuredGrid`` with the labels as cell data ``"region"`` (needs
+        pyvista)."""
+        try:
+            import pyvista as pv
+        except ImportError as e:
+            raise ImportError("to_pyvista needs pyvista: pip install pyvista") from e
+        n = self.n_tets
+        cells = np.hstack([np.full((n, 1), 4, dtype=np.int64), self.tets.astype(np.int64)])
+        grid = pv.UnstructuredGrid(
+            cells.ravel(), np.full(n, pv.CellType.TETRA, dtype=np.uint8), self.points
+        )
+        grid.cell_data["region"] = self.labels
+        return grid
+
+
+def _tet(out: tuple, report: bool = True) -> TetMesh:
+    points, tets, labels, text = out
+    return TetMesh(points, tets, labels, json.loads(text) if report else {})
+
+
+def _mesh_options(
+    size: float | None,
+    grading: float,
+    min_size: float | None,
+    max_size: float | None,
+    region_sizes: Mapping[int, float] | None,
+    resolution: float,
+    zone: str,
+    max_voxels: int,
+    steiner: bool,
+    stages: tuple[bool, bool, bool, bool],
+    threads: int | None,
+    progress: Callable[[str], Any] | None,
+) -> dict:
+    return dict(
+        size=size,
+        grading=grading,
+        min_size=min_size,
+        max_size=max_size,
+        region_sizes=sorted((int(k), float(v)) for k, v in (region_sizes or {}).items()),
+        resolution=resolution,
+        zone=zone,
+        max_voxels=max_voxels,
+        steiner=steiner,
+        stages=stages,
+        threads=threads,
+        progress=_progress(progress),
+    )
+
+
+def mesh(
+    vertices: Any,
+    faces: Any,
+    *,
+    labels: Sequence[int] | None = None,
+    side_labels: Any = None,
+    size: float | None = None,
+    grading: float = 0.3,
+    min_size: float | None = None,
+    max_size: float | None = None,
+    region_sizes: Mapping[int, float] | None = None,
+    resolution: float = 2.0,
+    zone: str = "euclidean",
+    max_voxels: int = 1 << 31,
+    steiner: bool = True,
+    recover: bool = True,
+    improve: bool = True,
+    smooth: bool = True,
+    polish: bool = True,
+    threads: int | None = None,
+    progress: Callable[[str], Any] | None = None,
+    name: str = "arrays",
+) -> TetMesh:
+    """Mesh the volume inside closed surfaces given as arrays, as ``biotet mesh`` does.
+
+    ``vertices`` (n×3) and ``faces`` (m×3 indices) hold one or more closed shells; each encloses
+    a region, innermost first, labelled ``labels`` (one per shell, in order of first triangle)
+    or 1, 2, ... by nesting. Or give ``side_labels`` (m×2: the region behind and in front of
+    each triangle) for a multi-material surface. Sizes: ``size`` (uniform), else from the
+    surface's own edges growing by ``grading`` per unit distance, clamped to
+    ``min_size``/``max_size``; ``region_sizes`` maps a region label to its size. ``steiner=False``
+    forbids interior points added by recovery; ``recover``/``improve``/``smooth``/``polish``
+    switch stages off. ``threads``: worker threads (default one per core; the result does not
+    depend on it). Raises :class:`InvalidSurfaceError` for an invalid surface and
+    :class:`MeshingError` if meshing cannot finish.
+    """
+    v = _points(vertices, "vertices")
+    f = _indices(faces, 3, "faces")
+    s = None if side_labels is None else _indices(side_labels, 2, "side_labels")
+    shell = None if labels is None else [int(x) for x in labels]
+    o = _mesh_options(
+        size, grading, min_size, max_size, region_sizes, resolution, zone, max_voxels,
+        steiner, (recover, improve, smooth, polish), threads, progress,
+    )
+    return _tet(_call(_core.mesh_arrays, v, f, shell, s, name, **o))
+
+
+def mesh_file(
+    paths: PathLike | Iterable[PathLike],
+    *,
+    labels: Mapping[str, Sequence[int]] | None = None,
+    size: float | None = None,
+    grading: float = 0.3,
+    min_size: float | None = None,
+    max_size: float | None = None,
+    region_sizes: Mapping[int, float] | None = None,
+    resolution: float = 2.0,
+    zone: str = "euclidean",
+    max_voxels: int = 1 << 31,
+    steiner: bool = True,
+    recover: bool = True,
+    improve: bool = True,
+    smooth: bool = True,
+    polish: bool = True,
+    threads: int | None = None,
+    progress: Callable[[str], Any] | None = None,
+) -> TetMesh:
+    """Mesh the volume inside the closed surfaces in one or more files (STL, OBJ, OFF, PLY,
+    Medit .mesh, VTU), exactly as ``biotet mesh FILE...`` does: the same tets, byte for byte,
+    for the same options. ``labels`` maps a file (as given, or its name) to the labels of its
+    shells, as ``--label FILE=N,...``. Other options as in :func:`mesh`."""
+    if isinstance(paths, (str, os.PathLike)):
+        paths = [paths]
+    ps = [os.fspath(p) for p in paths]
+    per_file: list[list[int] | None] = [None] * len(ps)
+    for key, ls in (labels or {}).items():
+        hits = [i for i, p in enumerate(ps) if p == key or os.path.basename(p) == key]
+        if not hits:
+            raise ValueError(f"labels: {key} is not one of the input files")
+        per_file[hits[0]] = [int(x) for x in ls]
+    o = _mesh_options(
+        size, grading, min_size, max_size, region_sizes, resolution, zone, max_voxels,
+        steiner, (recover, improve, smooth, polish), threads, progress,
+    )
+    return _tet(_call(_core.mesh_files, ps, per_file, **o))
+
+
+def _surface_arrays(surface: Surface | tuple[Any, Any] | None) -> tuple[Any, Any]:
+    if surface is None:
+        return None, None
+    if isinstance(surface, Surface):
+        return _points(surface.points), _indices(surface.triangles, 3, "triangles")
+    p, t = surface
+    return _points(p), _indices(t, 3, "triangles")
+
+
+def _side_labels(surface: Surface | tuple[Any, Any] | None) -> np.ndarray | None:
+    """A surface's side labels when they say more than "region 1 inside, outside beyond"."""
+    if isinstance(surface, Surface):
+        s = np.asarray(surface.sides)
+        if s.size and not (np.all(s[:, 0] == 1) and np.all(s[:, 1] == 0)):
+            return _indices(s, 2, "sides")
+    return None
+
+
+def _mesh_arrays(m: TetMesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    t = _indices(m.tets, 4, "tets")
+    return _points(m.points), t, _labels(m.labels, t.shape[0])
+
+
+def check(mesh: TetMesh, surface: Surface | tuple[Any, Any] | None = None, *,
+          labels: Sequence[int] | None = None, threads: int | None = None) -> dict:
+    """Check a tet mesh as ``biotet check`` does: indices, strictly positive tets (exact),
+    faces shared by at most two tets, adjacency, unused or duplicate points; and, with a
+    ``surface`` (a :class:`Surface`, its side labels included, or ``(points, triangles)`` whose
+    shells are labelled ``labels`` as in :func:`mesh`), that every surface triangle is a face
+    of the mesh with the right regions on its sides. Returns the report; ``report["valid"]`` is
+    the verdict."""
+    sp, st = _surface_arrays(surface)
+    shell = None if labels is None else [int(x) for x in labels]
+    return json.loads(_call(_core.check, *_mesh_arrays(mesh), sp, st, shell,
+                            _side_labels(surface), threads=threads))
+
+
+def quality(mesh: TetMesh, *, threads: int | None = None) -> dict:
+    """Quality measures of a tet mesh (``biotet quality --json``): dihedral angles, solid
+    angles, q, radius ratio, histograms, per region."""
+    return json.loads(_call(_core.quality, *_mesh_arrays(mesh), threads=threads))
+
+
+def delaunay(points: Any, *, threads: int | None = None) -> TetMesh:
+    """The exact Delaunay tetrahedralization of a point cloud (degenerate inputs get a symbolic
+    tie-break). Labels are 1."""
+    return _tet(_call(_core.delaunay, _points(points), threads=threads), report=False)
+
+
+def recover(mesh: TetMesh, surface: Surface | tuple[Any, Any], *, steiner: bool = True,
+            keep_outside: bool = False, threads: int | None = None) -> TetMesh:
+    """Make every triangle of ``surface`` a face of ``mesh`` (LAST RESORT boundary recovery),
+    never adding points on the surface; with ``steiner`` (the default) points strictly inside
+    are added where no fill exists without them. The outside tets are removed unless
+    ``keep_outside``. The report is the recovery's."""
+    sp, st = _surface_arrays(surface)
+    return _tet(_call(_core.recover_surface, *_mesh_arrays(mesh), sp, st, steiner=steiner,
+                      keep_outside=keep_outside, threads=threads))
+
+
+def improve(mesh: TetMesh, *, threshold: float = 10.0, metric: str = "dihedral",
+            threads: int | None = None) -> TetMesh:
+    """Remove slivers by refilling their cavities (LAST RESORT): tets whose smallest dihedral
+    angle (``metric="dihedral"``, degrees) or q (``metric="q"``) is under ``threshold``. Points
+    and surface are kept."""
+    return _tet(_call(_core.improve_mesh, *_mesh_arrays(mesh), threshold=threshold,
+                      metric=metric, threads=threads))
+
+
+def smooth(mesh: TetMesh, surface: Surface | tuple[Any, Any] | None = None, *,
+           slide: bool = False, max_sweeps: int | None = None,
+           threads: int | None = None) -> TetMesh:
+    """Raise the smallest solid angles by moving nodes (the surface fixed, or sliding on
+    ``surface`` with ``slide=True``)."""
+    sp, st = _surface_arrays(surface)
+    return _tet(_call(_core.smooth_mesh, *_mesh_arrays(mesh), sp, st, slide=slide,
+                      max_sweeps=max_sweeps, threads=threads))
+
+
+_SURFACE_ONLY = (".stl", ".obj", ".off", ".ply")
+
+
+def read(path: PathLike) -> TetMesh | Surface:
+    """Read a mesh file: a :class:`TetMesh` when it holds tets (.vtu, .mesh, .msh,
+    .node/.ele), else a :class:`Surface` (STL, OBJ, OFF, PLY, or a .vtu/.mesh of triangles)."""
+    p = os.fspath(path)
+    if p.lower().endswith(_SURFACE_ONLY):
+        return read_surface(p)
+    m = _tet(_call(_core.read_tet_mesh, p), report=False)
+    if m.n_tets == 0 and p.lower().endswith((".vtu", ".mesh")):
+        return read_surface(p)
+    return m
+
+
+def read_surface(path: PathLike) -> Surface:
+    """Read a triangle surface file (STL, OBJ, OFF, PLY, Medit, VTU) with its side labels."""
+    return Surface(*_call(_core.read_surface, os.fspath(path)))
+
+
+def write(path: PathLike, mesh: TetMesh) -> list[str]:
+    """Write a tet mesh (format from the extension: .vtu, .mesh, .msh, .node/.ele) through a
+    temporary file renamed into place. Returns the paths written."""
+    out = _call(_core.write_tet_mesh, os.fspath(path), *_mesh_arrays(mesh))
+    return [os.fspath(p) for p in out]

@@ -1,0 +1,178 @@
+//! numpy arrays to the library's types and back. Inputs are read through read-only views and
+//! checked (shape, indices, labels) with messages naming the array; outputs move the library's
+//! vectors into numpy without a copy.
+
+use biotet::mesh::shells::Part;
+use biotet::{SurfaceMesh, TetMesh};
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+/// A surface as given: closed shells with optional labels (assembled as `biotet mesh` does),
+/// or triangles with the region on each side.
+pub enum Surface {
+    Parts(Vec<Part>, String),
+    Sided(SurfaceMesh, String),
+}
+
+impl Surface {
+    pub fn name(&self) -> &str {
+        match self {
+            Surface::Parts(_, n) | Surface::Sided(_, n) => n,
+        }
+    }
+}
+
+fn shape_error(what: &str, want: usize, shape: &[usize]) -> PyErr {
+    PyValueError::new_err(format!(
+        "{what} must be an array of shape (n, {want}), not {shape:?}"
+    ))
+}
+
+/// Points from an (n, 3) float64 array.
+pub fn points_from(a: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<[f64; 3]>> {
+    let v = a.as_array();
+    if v.ncols() != 3 {
+        return Err(shape_error("points", 3, v.shape()));
+    }
+    Ok(v.rows().into_iter().map(|r| [r[0], r[1], r[2]]).collect())
+}
+
+/// Index rows of width `N` from an int64 array, each in `0..n_points`.
+fn indices_from<const N: usize>(
+    what: &str,
+    a: &PyReadonlyArray2<'_, i64>,
+    n_points: usize,
+) -> PyResult<Vec<[u32; N]>> {
+    let v = a.as_array();
+    if v.ncols() != N {
+        return Err(shape_error(what, N, v.shape()));
+    }
+    let mut out = Vec::with_capacity(v.nrows());
+    for (i, r) in v.rows().into_iter().enumerate() {
+        let mut row = [0u32; N];
+        for (k, x) in r.iter().enumerate() {
+            if *x < 0 || *x as u64 >= n_points as u64 {
+                return Err(PyValueError::new_err(format!(
+                    "{what}[{i}] refers to point {x}, outside 0..{n_points}"
+                )));
+            }
+            row[k] = *x as u32;
+        }
+        out.push(row);
+    }
+    Ok(out)
+}
+
+/// Labels from an int64 array of length `n`, each in `0..2³²`.
+fn labels_from(what: &str, a: &[i64]) -> PyResult<Vec<u32>> {
+    a.iter()
+        .enumerate()
+        .map(|(i, &l)| {
+            u32::try_from(l).map_err(|_| {
+                PyValueError::new_err(format!("{what}[{i}] = {l} is not a label in 0..2**32"))
+            })
+        })
+        .collect()
+}
+
+/// A surface from points, triangles and either shell labels or side labels.
+pub fn surface_from(
+    points: &PyReadonlyArray2<'_, f64>,
+    triangles: &PyReadonlyArray2<'_, i64>,
+    shell_labels: Option<Vec<u32>>,
+    side_labels: Option<&PyReadonlyArray2<'_, i64>>,
+    name: String,
+) -> PyResult<Surface> {
+    let pts = points_from(points)?;
+    let tris = indices_from::<3>("triangles", triangles, pts.len())?;
+    let n = tris.len();
+    match side_labels {
+        Some(sides) => {
+            let v = sides.as_array();
+            if v.ncols() != 2 || v.nrows() != n {
+                return Err(PyValueError::new_err(format!(
+                    "side_labels must have shape ({n}, 2), not {:?}",
+                    v.shape()
+                )));
+            }
+            let flat: Vec<i64> = v.iter().copied().collect();
+            let l = labels_from("side_labels", &flat)?;
+            let mut s = SurfaceMesh::closed(pts, tris, 1);
+            s.sides = l.chunks_exact(2).map(|c| [c[0], c[1]]).collect();
+            Ok(Surface::Sided(s, name))
+        }
+        None => Ok(Surface::Parts(
+            vec![Part {
+                surface: SurfaceMesh::closed(pts, tris, 1),
+                labels: shell_labels,
+            }],
+            name,
+        )),
+    }
+}
+
+/// A tet mesh from points, tets and labels (adjacency rebuilt).
+pub fn mesh_from(
+    points: &PyReadonlyArray2<'_, f64>,
+    tets: &PyReadonlyArray2<'_, i64>,
+    labels: &PyReadonlyArray1<'_, i64>,
+) -> PyResult<TetMesh> {
+    let pts = points_from(points)?;
+    let t = indices_from::<4>("tets", tets, pts.len())?;
+    let l = labels.as_array();
+    if l.len() != t.len() {
+        return Err(PyValueError::new_err(format!(
+            "labels has {} entries for {} tets",
+            l.len(),
+            t.len()
+        )));
+    }
+    let flat: Vec<i64> = l.iter().copied().collect();
+    Ok(TetMesh::new(pts, t, labels_from("labels", &flat)?))
+}
+
+/// Reinterpret indices as int32 (numpy's default index type) without a copy: every index is
+/// below 2³¹ since the library numbers points in u32 and no mesh has 2³¹ points.
+fn as_i32(v: Vec<u32>) -> Vec<i32> {
+    if v.iter().any(|&x| x > i32::MAX as u32) {
+        return v.into_iter().map(|x| x as i32).collect();
+    }
+    let mut v = std::mem::ManuallyDrop::new(v);
+    // SAFETY: u32 and i32 have the same size and alignment, every value fits, and the
+    // allocation is handed over whole (pointer, length, capacity).
+    unsafe { Vec::from_raw_parts(v.as_mut_ptr() as *mut i32, v.len(), v.capacity()) }
+}
+
+fn rows<T: numpy::Element>(py: Python<'_>, flat: Vec<T>, width: usize) -> Bound<'_, PyArray2<T>> {
+    let n = flat.len() / width;
+    Array2::from_shape_vec((n, width), flat)
+        .expect("rows of equal width")
+        .into_pyarray(py)
+}
+
+/// Points, tets and labels moved into numpy, with the report text.
+pub fn mesh_out(py: Python<'_>, mesh: TetMesh, report: String) -> crate::MeshOut<'_> {
+    let TetMesh {
+        points,
+        tets,
+        labels,
+        ..
+    } = mesh;
+    (
+        rows(py, points.into_flattened(), 3),
+        rows(py, as_i32(tets.into_flattened()), 4),
+        as_i32(labels).into_pyarray(py),
+        report,
+    )
+}
+
+/// A surface's points, triangles and side labels moved into numpy.
+pub fn surface_out(py: Python<'_>, s: SurfaceMesh) -> crate::SurfaceOut<'_> {
+    (
+        rows(py, s.points.into_flattened(), 3),
+        rows(py, as_i32(s.triangles.into_flattened()), 3),
+        rows(py, as_i32(s.sides.into_flattened()), 2),
+    )
+}

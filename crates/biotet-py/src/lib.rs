@@ -1,0 +1,610 @@
+//! The native part of the `biotet` Python package (`biotet._core`): numpy arrays in and out,
+//! the library's functions run with the GIL released, errors as one exception type carrying a
+//! kind, the message and the offending triangles (the pure-Python layer maps the kind to
+//! `InvalidSurfaceError`, `MeshingError` or an `OSError`).
+//!
+//! Inputs are borrowed read-only from numpy and copied once into the library's types (the
+//! library owns its arrays); outputs are moved into numpy without a copy.
+
+mod arrays;
+mod run;
+
+use arrays::{Surface, mesh_from, mesh_out, points_from, surface_from};
+use biotet::TetMesh;
+use biotet::check::check as check_mesh;
+use biotet::delaunay::Delaunay;
+use biotet::lastresort::{ImproveOptions, Metric, RecoverOptions, improve, recover};
+use biotet::mesh::shells::{Part, assemble};
+use biotet::mesh::side_labels;
+use biotet::mesh::validate::{ValidateOptions, validate_surface};
+use biotet::pipeline::{PipelineOptions, mesh_surface};
+use biotet::quality::{QualityReport, forced};
+use biotet::sizing::{SizeSpec, Sizing, SizingOptions};
+use biotet::smooth::{Boundary, SmoothOptions, smooth};
+use biotet::template::Zone;
+use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::prelude::*;
+use run::{Failure, Kind, guarded};
+use serde_json::json;
+use std::path::PathBuf;
+
+pyo3::create_exception!(
+    _core,
+    CoreError,
+    pyo3::exceptions::PyException,
+    "A failure inside biotet: args are (kind, message, triangles)."
+);
+
+/// A tet mesh handed to Python: points (n×3 float64), tets (m×4 int32), labels (m int32) and
+/// the report as JSON text.
+type MeshOut<'py> = (
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<i32>>,
+    Bound<'py, PyArray1<i32>>,
+    String,
+);
+
+/// A surface handed to Python: points (n×3 float64), triangles (m×3 int32) and the side labels
+/// (m×2 int32).
+type SurfaceOut<'py> = (
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<i32>>,
+    Bound<'py, PyArray2<i32>>,
+);
+
+/// Tets under this smallest dihedral angle are reported as forced when an input face or fold
+/// under it causes them (as `biotet mesh` does).
+const FORCED_DEG: f64 = 10.0;
+
+/// Sizing and stage switches of `mesh`, as the CLI's flags.
+struct MeshOptions {
+    size: Option<f64>,
+    grading: f64,
+    min_size: Option<f64>,
+    max_size: Option<f64>,
+    region_sizes: Vec<(u32, f64)>,
+    resolution: f64,
+    box_zones: bool,
+    max_voxels: usize,
+    steiner: bool,
+    stages: [bool; 4],
+}
+
+/// Validate a labelled surface as `biotet mesh` does: shells assembled and labelled innermost
+/// first, or the file's own side labels resolved against the geometry.
+fn prepare(surface: Surface) -> Result<(biotet::SurfaceMesh, serde_json::Value), Failure> {
+    let opts = ValidateOptions::default();
+    match surface {
+        Surface::Parts(parts, name) => {
+            let (mut s, shells) = assemble(parts).map_err(|e| {
+                Failure::new(
+                    Kind::InvalidSurface,
+                    format!("{name}: cannot assemble the surfaces: {e}"),
+                )
+            })?;
+            validate_surface(&mut s, &opts).map_err(|e| Failure::invalid(&name, &e))?;
+            Ok((s, serde_json::to_value(shells).unwrap_or_default()))
+        }
+        Surface::Sided(mut s, name) => {
+            let partial = s
+                .sides
+                .iter()
+                .flatten()
+                .any(|&l| l == side_labels::FROM_GEOMETRY);
+            if !partial {
+                validate_surface(&mut s, &opts).map_err(|e| Failure::invalid(&name, &e))?;
+            }
+            let resolved = side_labels::resolve(&s).map_err(|e| {
+                Failure::new(
+                    Kind::InvalidSurface,
+                    format!("{name}: side labels disagree with the geometry: {e}"),
+                )
+            })?;
+            let mut s = resolved.surface;
+            validate_surface(&mut s, &opts).map_err(|e| Failure::invalid(&name, &e))?;
+            Ok((s, serde_json::to_value(resolved.shells).unwrap_or_default()))
+        }
+    }
+}
+
+/// The pipeline on a surface, with the report `biotet mesh --json` gives (without its
+/// process-level figures: memory, reading time).
+fn mesh_with(
+    surface: Surface,
+    o: &MeshOptions,
+    progress: &dyn Fn(&str),
+) -> Result<(TetMesh, serde_json::Value), Failure> {
+    let name = surface.name().to_string();
+    let (surface, shells) = prepare(surface)?;
+    let spec = match o.size {
+        Some(h) => SizeSpec::Uniform(h),
+        None => SizeSpec::FromSurface { grading: o.grading },
+    };
+    let mut sizing = SizingOptions::new(spec);
+    sizing.min_size = o.min_size;
+    sizing.max_size = o.max_size;
+    sizing.region_sizes = o.region_sizes.clone();
+    let clock = std::time::Instant::now();
+    let sizing = Sizing::new(&surface, sizing)
+        .map_err(|e| Failure::new(Kind::Value, format!("sizing: {e}")))?;
+    let seconds_sizing = clock.elapsed().as_secs_f64();
+    let mut opts = PipelineOptions::default();
+    opts.deploy.resolution = o.resolution;
+    opts.deploy.zone = if o.box_zones {
+        Zone::Box
+    } else {
+        Zone::Euclidean
+    };
+    opts.deploy.max_voxels = o.max_voxels;
+    let [recover_on, improve_on, smooth_on, polish_on] = o.stages;
+    if !recover_on {
+        opts.recover = None;
+    }
+    if let Some(r) = opts.recover.as_mut() {
+        r.allow_interior_steiner = o.steiner;
+    }
+    if !improve_on {
+        opts.improve = None;
+    }
+    if !smooth_on {
+        opts.smooth = None;
+    }
+    if !o.steiner
+        && let Some(p) = opts.polish.as_mut()
+    {
+        p.insert = false;
+    }
+    if !polish_on || !improve_on {
+        opts.polish = None;
+    }
+    let (mesh, report) = mesh_surface(&surface, sizing, &opts, &mut |s| progress(s))
+        .map_err(|e| Failure::new(Kind::Meshing, format!("{name}: {e}")))?;
+    let quality = QualityReport::of(&mesh);
+    let forcing = forced::summarise(
+        &mesh,
+        &forced::classify(&mesh, &surface, FORCED_DEG),
+        FORCED_DEG,
+    );
+    if let Some(r) = report.recover.as_ref().filter(|r| !r.is_complete()) {
+        let triangles = r.unrecovered.iter().map(|u| u.triangle as u32).collect();
+        return Err(Failure {
+            kind: Kind::Meshing,
+            message: format!(
+                "{name}: {} input triangles could not be recovered",
+                r.missing_after
+            ),
+            triangles,
+        });
+    }
+    let report = json!({
+        "input": name,
+        "n_surface_triangles": surface.triangles.len(),
+        "shells": shells,
+        "seconds_sizing": seconds_sizing,
+        "pipeline": report,
+        "quality": quality,
+        "forcing": forcing,
+        "mesh_bytes": mesh.bytes(),
+    });
+    Ok((mesh, report))
+}
+
+/// Read the options shared by `mesh_arrays` and `mesh_files`.
+#[allow(clippy::too_many_arguments)]
+fn mesh_options(
+    size: Option<f64>,
+    grading: f64,
+    min_size: Option<f64>,
+    max_size: Option<f64>,
+    region_sizes: Vec<(u32, f64)>,
+    resolution: f64,
+    zone: &str,
+    max_voxels: usize,
+    steiner: bool,
+    stages: [bool; 4],
+) -> PyResult<MeshOptions> {
+    let box_zones = match zone {
+        "euclidean" => false,
+        "box" => true,
+        z => {
+            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "zone must be 'euclidean' or 'box', not {z:?}"
+            )));
+        }
+    };
+    Ok(MeshOptions {
+        size,
+        grading,
+        min_size,
+        max_size,
+        region_sizes,
+        resolution,
+        box_zones,
+        max_voxels,
+        steiner,
+        stages,
+    })
+}
+
+/// Mesh the volume inside a closed surface given as arrays (see `biotet.mesh`).
+#[pyfunction]
+#[pyo3(signature = (points, triangles, shell_labels, side_labels, name, size, grading, min_size,
+    max_size, region_sizes, resolution, zone, max_voxels, steiner, stages, threads, progress))]
+#[allow(clippy::too_many_arguments)]
+fn mesh_arrays<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    triangles: PyReadonlyArray2<'py, i64>,
+    shell_labels: Option<Vec<u32>>,
+    side_labels: Option<PyReadonlyArray2<'py, i64>>,
+    name: String,
+    size: Option<f64>,
+    grading: f64,
+    min_size: Option<f64>,
+    max_size: Option<f64>,
+    region_sizes: Vec<(u32, f64)>,
+    resolution: f64,
+    zone: &str,
+    max_voxels: usize,
+    steiner: bool,
+    stages: [bool; 4],
+    threads: Option<usize>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<MeshOut<'py>> {
+    let o = mesh_options(
+        size,
+        grading,
+        min_size,
+        max_size,
+        region_sizes,
+        resolution,
+        zone,
+        max_voxels,
+        steiner,
+        stages,
+    )?;
+    let surface = surface_from(
+        &points,
+        &triangles,
+        shell_labels,
+        side_labels.as_ref(),
+        name,
+    )?;
+    let (mesh, report) = guarded(py, threads, move || {
+        mesh_with(surface, &o, &|s| run::report_progress(progress.as_ref(), s))
+    })?;
+    Ok(mesh_out(py, mesh, report.to_string()))
+}
+
+/// Mesh the volume inside the closed surfaces in files (see `biotet.mesh_file`).
+#[pyfunction]
+#[pyo3(signature = (paths, labels, size, grading, min_size, max_size, region_sizes, resolution,
+    zone, max_voxels, steiner, stages, threads, progress))]
+#[allow(clippy::too_many_arguments)]
+fn mesh_files<'py>(
+    py: Python<'py>,
+    paths: Vec<PathBuf>,
+    labels: Vec<Option<Vec<u32>>>,
+    size: Option<f64>,
+    grading: f64,
+    min_size: Option<f64>,
+    max_size: Option<f64>,
+    region_sizes: Vec<(u32, f64)>,
+    resolution: f64,
+    zone: &str,
+    max_voxels: usize,
+    steiner: bool,
+    stages: [bool; 4],
+    threads: Option<usize>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<MeshOut<'py>> {
+    let o = mesh_options(
+        size,
+        grading,
+        min_size,
+        max_size,
+        region_sizes,
+        resolution,
+        zone,
+        max_voxels,
+        steiner,
+        stages,
+    )?;
+    let (mesh, report) = guarded(py, threads, move || {
+        let surface = read_surfaces(&paths, labels)?;
+        mesh_with(surface, &o, &|s| run::report_progress(progress.as_ref(), s))
+    })?;
+    Ok(mesh_out(py, mesh, report.to_string()))
+}
+
+/// Surfaces from files as `biotet mesh` reads them: one side-labelled file alone, or closed
+/// shells from one or more files with optional labels per file.
+fn read_surfaces(paths: &[PathBuf], labels: Vec<Option<Vec<u32>>>) -> Result<Surface, Failure> {
+    let mut parts = Vec::new();
+    for (p, l) in paths
+        .iter()
+        .zip(labels.into_iter().chain(std::iter::repeat(None)))
+    {
+        let read = biotet_io::read_surface(p).map_err(Failure::io)?;
+        if let Some(sides) = read.side_labels {
+            if paths.len() > 1 {
+                return Err(Failure::new(
+                    Kind::Value,
+                    format!(
+                        "{}: a surface with side labels holds every region and must be given alone",
+                        p.display()
+                    ),
+                ));
+            }
+            let mut s = read.mesh;
+            s.sides = sides;
+            return Ok(Surface::Sided(s, p.display().to_string()));
+        }
+        parts.push(Part {
+            surface: read.mesh,
+            labels: l,
+        });
+    }
+    let name = paths
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect::<Vec<_>>()
+        .join(" + ");
+    Ok(Surface::Parts(parts, name))
+}
+
+/// Check a tet mesh and, given a surface, that it holds every surface triangle; the report as
+/// JSON text.
+#[pyfunction]
+#[pyo3(signature = (points, tets, labels, surface_points=None, surface_triangles=None,
+    shell_labels=None, side_labels=None, threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn check<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    tets: PyReadonlyArray2<'py, i64>,
+    labels: PyReadonlyArray1<'py, i64>,
+    surface_points: Option<PyReadonlyArray2<'py, f64>>,
+    surface_triangles: Option<PyReadonlyArray2<'py, i64>>,
+    shell_labels: Option<Vec<u32>>,
+    side_labels: Option<PyReadonlyArray2<'py, i64>>,
+    threads: Option<usize>,
+) -> PyResult<String> {
+    let mesh = mesh_from(&points, &tets, &labels)?;
+    let surface = match (&surface_points, &surface_triangles) {
+        (Some(p), Some(t)) => Some(surface_from(
+            p,
+            t,
+            shell_labels,
+            side_labels.as_ref(),
+            "surface".into(),
+        )?),
+        (None, None) => None,
+        _ => {
+            return Err(pyo3::exceptions::PyValueError::new_err(
+                "give both surface_points and surface_triangles, or neither",
+            ));
+        }
+    };
+    guarded(py, threads, move || {
+        let surface = surface.map(prepare).transpose()?.map(|(s, _)| s);
+        let c = check_mesh(&mesh, surface.as_ref());
+        Ok(serde_json::to_string(&c).unwrap_or_default())
+    })
+}
+
+/// Quality measures of a tet mesh (the report of `biotet quality --json`) as JSON text.
+#[pyfunction]
+#[pyo3(signature = (points, tets, labels, threads=None))]
+fn quality<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    tets: PyReadonlyArray2<'py, i64>,
+    labels: PyReadonlyArray1<'py, i64>,
+    threads: Option<usize>,
+) -> PyResult<String> {
+    let mesh = mesh_from(&points, &tets, &labels)?;
+    guarded(py, threads, move || {
+        Ok(serde_json::to_string(&QualityReport::of(&mesh)).unwrap_or_default())
+    })
+}
+
+/// The Delaunay tetrahedralization of a point cloud.
+#[pyfunction]
+#[pyo3(signature = (points, threads=None))]
+fn delaunay<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    threads: Option<usize>,
+) -> PyResult<MeshOut<'py>> {
+    let pts = points_from(&points)?;
+    let mesh = guarded(py, threads, move || {
+        let dt = Delaunay::from_points(pts)
+            .map_err(|e| Failure::new(Kind::Value, format!("delaunay: {e}")))?;
+        Ok(dt.to_tet_mesh())
+    })?;
+    Ok(mesh_out(py, mesh, "{}".into()))
+}
+
+/// Boundary recovery (LAST RESORT) of a surface in a tet mesh.
+#[pyfunction]
+#[pyo3(signature = (points, tets, labels, surface_points, surface_triangles, steiner=true,
+    keep_outside=false, threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn recover_surface<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    tets: PyReadonlyArray2<'py, i64>,
+    labels: PyReadonlyArray1<'py, i64>,
+    surface_points: PyReadonlyArray2<'py, f64>,
+    surface_triangles: PyReadonlyArray2<'py, i64>,
+    steiner: bool,
+    keep_outside: bool,
+    threads: Option<usize>,
+) -> PyResult<MeshOut<'py>> {
+    let mut mesh = mesh_from(&points, &tets, &labels)?;
+    let surface = surface_from(
+        &surface_points,
+        &surface_triangles,
+        None,
+        None,
+        "surface".into(),
+    )?;
+    let (mesh, report) = guarded(py, threads, move || {
+        let (s, _) = prepare(surface)?;
+        let opts = RecoverOptions {
+            allow_interior_steiner: steiner,
+            remove_outside: !keep_outside,
+            ..RecoverOptions::default()
+        };
+        let r = recover(&mut mesh, &s, &opts)
+            .map_err(|e| Failure::new(Kind::Meshing, format!("recover: {e}")))?;
+        if !r.is_complete() {
+            return Err(Failure {
+                kind: Kind::Meshing,
+                message: format!(
+                    "recover: {} input triangles could not be recovered",
+                    r.missing_after
+                ),
+                triangles: r.unrecovered.iter().map(|u| u.triangle as u32).collect(),
+            });
+        }
+        Ok((mesh, serde_json::to_string(&r).unwrap_or_default()))
+    })?;
+    Ok(mesh_out(py, mesh, report))
+}
+
+/// Sliver removal (LAST RESORT) in place of a tet mesh's poor tets.
+#[pyfunction]
+#[pyo3(signature = (points, tets, labels, threshold=10.0, metric="dihedral", threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn improve_mesh<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    tets: PyReadonlyArray2<'py, i64>,
+    labels: PyReadonlyArray1<'py, i64>,
+    threshold: f64,
+    metric: &str,
+    threads: Option<usize>,
+) -> PyResult<MeshOut<'py>> {
+    let metric = match metric {
+        "dihedral" => Metric::Dihedral,
+        "q" => Metric::Q,
+        m => {
+            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "metric must be 'dihedral' or 'q', not {m:?}"
+            )));
+        }
+    };
+    let mut mesh = mesh_from(&points, &tets, &labels)?;
+    let (mesh, report) = guarded(py, threads, move || {
+        let opts = ImproveOptions {
+            metric,
+            threshold,
+            ..ImproveOptions::default()
+        };
+        let r = improve(&mut mesh, &opts);
+        Ok((mesh, serde_json::to_string(&r).unwrap_or_default()))
+    })?;
+    Ok(mesh_out(py, mesh, report))
+}
+
+/// Solid-angle smoothing of a tet mesh (surface fixed, or sliding on the given surface).
+#[pyfunction]
+#[pyo3(signature = (points, tets, labels, surface_points=None, surface_triangles=None,
+    slide=false, max_sweeps=None, threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn smooth_mesh<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    tets: PyReadonlyArray2<'py, i64>,
+    labels: PyReadonlyArray1<'py, i64>,
+    surface_points: Option<PyReadonlyArray2<'py, f64>>,
+    surface_triangles: Option<PyReadonlyArray2<'py, i64>>,
+    slide: bool,
+    max_sweeps: Option<usize>,
+    threads: Option<usize>,
+) -> PyResult<MeshOut<'py>> {
+    let mut mesh = mesh_from(&points, &tets, &labels)?;
+    let surface = match (&surface_points, &surface_triangles) {
+        (Some(p), Some(t)) => Some(surface_from(p, t, None, None, "surface".into())?),
+        _ => None,
+    };
+    let (mesh, report) = guarded(py, threads, move || {
+        let surface = surface.map(prepare).transpose()?.map(|(s, _)| s);
+        let mut opts = SmoothOptions {
+            boundary: if slide {
+                Boundary::Slide
+            } else {
+                Boundary::Fixed
+            },
+            ..SmoothOptions::default()
+        };
+        if let Some(n) = max_sweeps {
+            opts.max_sweeps = n;
+        }
+        let r = smooth(&mut mesh, surface.as_ref(), &opts)
+            .map_err(|e| Failure::new(Kind::Value, format!("smooth: {e}")))?;
+        Ok((mesh, serde_json::to_string(&r).unwrap_or_default()))
+    })?;
+    Ok(mesh_out(py, mesh, report))
+}
+
+/// Read a tet mesh file: (points, tets, labels, "{}").
+#[pyfunction]
+fn read_tet_mesh<'py>(py: Python<'py>, path: PathBuf) -> PyResult<MeshOut<'py>> {
+    let mesh = guarded(py, None, move || {
+        Ok(biotet_io::read_tet_mesh(&path).map_err(Failure::io)?.mesh)
+    })?;
+    Ok(mesh_out(py, mesh, "{}".into()))
+}
+
+/// Read a surface file: (points, triangles, sides) with sides the region labels behind and in
+/// front of each triangle (`[1, 0]` for a plain closed surface).
+#[pyfunction]
+fn read_surface<'py>(py: Python<'py>, path: PathBuf) -> PyResult<SurfaceOut<'py>> {
+    let s = guarded(py, None, move || {
+        let read = biotet_io::read_surface(&path).map_err(Failure::io)?;
+        let mut s = read.mesh;
+        if let Some(sides) = read.side_labels {
+            s.sides = sides;
+        }
+        Ok(s)
+    })?;
+    Ok(arrays::surface_out(py, s))
+}
+
+/// Write a tet mesh (format from the extension; written to a temporary file, then renamed).
+/// Returns the paths written.
+#[pyfunction]
+fn write_tet_mesh<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    points: PyReadonlyArray2<'py, f64>,
+    tets: PyReadonlyArray2<'py, i64>,
+    labels: PyReadonlyArray1<'py, i64>,
+) -> PyResult<Vec<PathBuf>> {
+    let mesh = mesh_from(&points, &tets, &labels)?;
+    guarded(py, None, move || {
+        biotet_io::write_tet_mesh(&path, &mesh).map_err(Failure::io)
+    })
+}
+
+/// The native module.
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("CoreError", m.py().get_type::<CoreError>())?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add_function(wrap_pyfunction!(mesh_arrays, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh_files, m)?)?;
+    m.add_function(wrap_pyfunction!(check, m)?)?;
+    m.add_function(wrap_pyfunction!(quality, m)?)?;
+    m.add_function(wrap_pyfunction!(delaunay, m)?)?;
+    m.add_function(wrap_pyfunction!(recover_surface, m)?)?;
+    m.add_function(wrap_pyfunction!(improve_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(smooth_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(read_tet_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(read_surface, m)?)?;
+    m.add_function(wrap_pyfunction!(write_tet_mesh, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,37 @@
+"""The Dask cohort example on three small subjects (one invalid) with a 2-process LocalCluster."""
+
+import csv
+import subprocess
+import sys
+
+import pytest
+
+import biotet
+from conftest import ROOT, SHAPES
+
+pytest.importorskip("dask.distributed")
+
+
+def test_cohort_example_meshes_each_subject_and_reports_failures(tmp_path):
+    inputs = [SHAPES / "tm_box.off", SHAPES / "tm_torus.off", SHAPES / "invalid_open_box.off"]
+    out = tmp_path / "out"
+    r = subprocess.run(
+        [sys.executable, str(ROOT / "examples" / "cohort_dask.py"), *map(str, inputs),
+         "-o", str(out), "--workers", "2"],
+        capture_output=True, text=True, timeout=600,
+    )
+    # One subject is invalid: exit 1, the others meshed.
+    assert r.returncode == 1, r.stderr
+    assert "2 of 3 subjects meshed" in r.stdout
+    rows = {row["subject"]: row for row in csv.DictReader(open(out / "summary.csv"))}
+    assert set(rows) == {"tm_box", "tm_torus", "invalid_open_box"}
+    assert rows["invalid_open_box"]["status"] == "failed"
+    assert "closed" in rows["invalid_open_box"]["error"]
+    for name in ("tm_box", "tm_torus"):
+        row = rows[name]
+        assert row["status"] == "ok"
+        m = biotet.read(out / f"{name}.vtu")
+        assert m.n_tets == int(row["tets"])
+        assert biotet.check(m, biotet.read_surface(SHAPES / f"{name}.off"))["valid"]
+        assert (out / f"{name}.json").is_file()
+    assert not (out / "invalid_open_box.vtu").exists()

@@ -1,0 +1,98 @@
+"""Bad input: the CLI's messages as Python exceptions, never a crash."""
+
+import numpy as np
+import pytest
+
+import biotet
+from conftest import SHAPES, cube
+
+
+def test_open_surface_is_invalid_naming_triangles():
+    with pytest.raises(biotet.InvalidSurfaceError) as e:
+        biotet.mesh_file(SHAPES / "invalid_open_box.off")
+    assert isinstance(e.value, ValueError)
+    assert "invalid_open_box.off" in str(e.value) and "closed" in str(e.value)
+    assert e.value.triangles and all(isinstance(t, int) for t in e.value.triangles)
+
+
+def test_hole_flipped_and_crossing_cubes():
+    p, t = cube()
+    cases = {
+        "closed": (p, t[:-1]),
+        "orient": (p, np.vstack([t[:3], t[3:4, [0, 2, 1]], t[4:]])),
+    }
+    q, u = cube((0.5, 0.25, 0.25), 0.5)
+    q = q * [2.0, 1.0, 1.0] - [0.5, 0, 0]
+    cases["intersect"] = (np.vstack([p, q]), np.vstack([t, u + 8]))
+    for word, (pp, tt) in cases.items():
+        with pytest.raises(biotet.InvalidSurfaceError) as e:
+            biotet.mesh(pp, tt)
+        assert word in str(e.value).lower(), str(e.value)
+        assert "triangle" in str(e.value)
+        assert e.value.triangles, word
+        assert max(e.value.triangles) < len(tt)
+
+
+def test_degenerate_triangle_names_it():
+    p, t = cube()
+    p = np.vstack([p, p[0]])
+    t = np.vstack([t, [[0, 1, 8]]])
+    with pytest.raises(biotet.InvalidSurfaceError):
+        biotet.mesh(p, t)
+
+
+def test_missing_and_garbage_files(tmp_path):
+    with pytest.raises(FileNotFoundError) as e:
+        biotet.mesh_file(tmp_path / "nope.stl")
+    assert isinstance(e.value, biotet.BiotetFileError)
+    assert "nope.stl" in str(e.value)
+    g = tmp_path / "garbage.msh"
+    g.write_text("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 2 1")
+    with pytest.raises(OSError) as e:
+        biotet.read(g)
+    assert "garbage.msh" in str(e.value)
+    bad = tmp_path / "bad.off"
+    bad.write_text("OFF\n3 1 0\n0 0 0\n1 0 0\n")
+    with pytest.raises(biotet.BiotetFileError) as e:
+        biotet.mesh_file(bad)
+    assert "bad.off" in str(e.value)
+    with pytest.raises(biotet.BiotetFileError) as e:
+        biotet.read(tmp_path / "x.unknown")
+    assert "extension" in str(e.value)
+
+
+@pytest.mark.parametrize(
+    "points, faces, msg",
+    [
+        (np.zeros((4, 2)), [[0, 1, 2]], "shape"),
+        (np.zeros((4, 3)), [[0, 1, 9]], "outside"),
+        (np.zeros((4, 3)), [[0, 1, -1]], "outside"),
+        (np.zeros((4, 3)), [[0.5, 1, 2]], "integers"),
+        (np.zeros((4, 3)), np.zeros((0, 3), int), "empty"),
+        (np.full((4, 3), np.nan), [[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]], "finite"),
+    ],
+)
+def test_bad_arrays_raise_value_errors(points, faces, msg):
+    with pytest.raises(ValueError) as e:
+        biotet.mesh(points, faces)
+    assert msg in str(e.value).lower()
+
+
+def test_bad_options_raise_value_errors():
+    p, t = cube()
+    with pytest.raises(ValueError):
+        biotet.mesh(p, t, zone="round")
+    with pytest.raises(ValueError):
+        biotet.mesh(p, t, size=-1.0)
+    with pytest.raises(ValueError):
+        biotet.mesh_file(SHAPES / "tm_box.off", labels={"other.off": [1]})
+
+
+def test_write_nothing_on_a_failed_write(tmp_path):
+    p, t = cube()
+    m = biotet.mesh(p, t)
+    with pytest.raises(OSError):
+        m.write(tmp_path / "no" / "such" / "dir.vtu")
+    with pytest.raises(biotet.BiotetFileError):
+        m.write(tmp_path / "out.unknown")
+    assert not any(tmp_path.iterdir())

@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# Every test: the Rust workspace (cargo test), then the Python package built from
+# crates/biotet-py into a virtual environment under target/ and its pytest suite (which
+# compares with the CLI binary cargo test just built).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cargo test --workspace --locked
+venv=target/pyenv
+if [ ! -x "$venv/bin/python" ]; then
+  "${PYTHON:-python3}" -m venv "$venv"
+fi
+"$venv/bin/python" -m pip install -q --upgrade pip
+"$venv/bin/python" -m pip install -q ./crates/biotet-py pytest meshio "dask[distributed]"
+BIOTET_CLI="$PWD/target/debug/biotet" "$venv/bin/python" -m pytest -q crates/biotet-py/tests
