@@ -10,5 +10,5 @@ if [ ! -x "$venv/bin/python" ]; then
   "${PYTHON:-python3}" -m venv "$venv"
 fi
 "$venv/bin/python" -m pip install -q --upgrade pip
-"$venv/bin/python" -m pip install -q ./crates/biotet-py pytest meshio "dask[distributed]"
+"$venv/bin/python" -m pip install -q ./crates/biotet-py pytest meshio pyvista "dask[distributed]"
 BIOTET_CLI="$PWD/target/debug/biotet" "$venv/bin/python" -m pytest -q crates/biotet-py/tests

@@ -60,6 +60,9 @@ enum Command {
     Recover(cmd::recover::Args),
     /// Remove slivers by refilling their cavities (LAST RESORT); points and surface untouched.
     Improve(cmd::improve::Args),
+    /// Remesh part of a tet mesh in place: one region, or the tets meeting a box or a sphere,
+    /// at a new size; every other tet kept exactly.
+    Remesh(cmd::remesh::Args),
     /// Validate closed surfaces: closed, manifold, consistently oriented, no self-intersection.
     Validate(cmd::validate::Args),
 }
@@ -106,6 +109,7 @@ fn main() -> ExitCode {
         Command::Mesh(a) => cmd::mesh::run(a),
         Command::Recover(a) => cmd::recover::run(a),
         Command::Improve(a) => cmd::improve::run(a),
+        Command::Remesh(a) => cmd::remesh::run(a),
         Command::Smooth(a) => cmd::smooth::run(a),
     };
     match result {

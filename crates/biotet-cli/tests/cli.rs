@@ -1558,3 +1558,55 @@ fn a_region_pinched_at_an_edge_is_refused_naming_the_edge() {
         assert!(!out.exists());
     }
 }
+
+#[test]
+fn remesh_replaces_a_zone_keeps_the_rest_and_refuses_a_missing_zone() {
+    let dir = tempfile::tempdir().unwrap();
+    let surface = root().join("tests/data/shapes/tm_icosphere.off");
+    let base = dir.path().join("base.vtu");
+    let out = biotet(&["mesh", s(&surface), "-o", s(&base), "--quiet"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let before = json_of(&biotet(&["quality", s(&base), "--json"]));
+    // A ball and a box (negative coordinates without '=') at a finer size.
+    for zone in [
+        ["--sphere", "0.3,0,0,0.4"],
+        ["--box", "-0.5,-0.5,-0.2,0.2,0.1,0.5"],
+    ] {
+        let new = dir.path().join("new.vtu");
+        let out = biotet(&[
+            "remesh",
+            s(&base),
+            zone[0],
+            zone[1],
+            "--size",
+            "0.1",
+            "-o",
+            s(&new),
+            "--json",
+        ]);
+        assert!(out.status.success(), "{zone:?}: {}", stderr(&out));
+        let j = json_of(&out);
+        let r = &j["remesh"];
+        let kept = r["tets_kept"].as_u64().unwrap();
+        let after = r["tets_after"].as_u64().unwrap();
+        assert!(
+            kept > 0 && after > r["tets_before"].as_u64().unwrap(),
+            "{r}"
+        );
+        let v0 = before["volume"].as_f64().unwrap();
+        let v1 = j["quality"]["volume"].as_f64().unwrap();
+        assert!((v0 - v1).abs() < 1e-9 * v0, "{v0} vs {v1}");
+        let check = biotet(&["check", s(&new), "-s", s(&surface)]);
+        assert!(check.status.success(), "{zone:?}: {}", stderr(&check));
+    }
+    // No zone, or a zone with no tet: an error naming the input, nothing written.
+    let none = dir.path().join("none.vtu");
+    for args in [vec![], vec!["--sphere", "10,10,10,1"]] {
+        let mut a = vec!["remesh", s(&base), "-o", s(&none), "--size", "0.1"];
+        a.extend(args);
+        let out = biotet(&a);
+        assert_eq!(out.status.code(), Some(2));
+        assert!(stderr(&out).starts_with("error: "), "{}", stderr(&out));
+        assert!(!none.exists());
+    }
+}

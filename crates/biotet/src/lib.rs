@@ -20,6 +20,7 @@ pub mod pipeline2d;
 pub mod polish;
 pub mod quality;
 pub mod recover2d;
+pub mod remesh;
 pub mod sizing;
 pub mod sizing_grid;
 pub mod smooth;

@@ -9,5 +9,6 @@ pub mod mesh;
 pub mod plane;
 pub mod quality;
 pub mod recover;
+pub mod remesh;
 pub mod smooth;
 pub mod validate;

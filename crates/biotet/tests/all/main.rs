@@ -9,6 +9,7 @@ mod plane;
 mod polish;
 mod predicates;
 mod quality;
+mod remesh;
 mod shells;
 mod side_labels;
 mod sizing;
