@@ -424,8 +424,16 @@ pub fn missing_triangles(mesh: &TetMesh, surface: &SurfaceMesh) -> usize {
         .count()
 }
 
-/// Append the corners of a box a quarter of the extent larger than the points' bounding box on
-/// every side, labelled 0 (outside).
+/// How far the enclosing corners stand off the points' bounding box, in extents. A large face
+/// is a Delaunay face only if some sphere through its corners is empty: with interior nodes at
+/// height h over a face of circumradius R, that sphere bulges at most h inward, so its radius is
+/// about R²/2h and its centre that far outside. Corners a quarter extent out sat in those
+/// spheres, and a unit cube at `--size 0.1` lost all 12 triangles; 64 extents keep them out down
+/// to sizes near a hundredth of the extent, and beyond that only outside tets are affected.
+const ENCLOSE_MARGIN: f64 = 64.0;
+
+/// Append the corners of a box [`ENCLOSE_MARGIN`] extents larger than the points' bounding box
+/// on every side, labelled 0 (outside).
 fn enclose(points: &mut Vec<[f64; 3]>, regions: &mut Vec<u32>) {
     if points.is_empty() {
         return;
@@ -442,7 +450,7 @@ fn enclose(points: &mut Vec<[f64; 3]>, regions: &mut Vec<u32>) {
         .map(|k| hi[k] - lo[k])
         .fold(0.0, f64::max)
         .max(1e-300);
-    let margin = 0.25 * extent;
+    let margin = ENCLOSE_MARGIN * extent;
     for i in 0..8 {
         let pick = |k: usize| {
             if i >> k & 1 == 0 {

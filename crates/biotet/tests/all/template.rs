@@ -319,3 +319,31 @@ fn size_finer_than_the_surface_keeps_nodes_out_of_triangle_circumspheres() {
     assert!(c.valid, "{:?}", c.problems);
     assert_eq!(report.recover.as_ref().unwrap().steiner_points, 0);
 }
+
+#[test]
+fn a_cube_at_a_size_far_finer_than_its_faces_meshes() {
+    // Twelve triangles of circumradius 0.71 over interior nodes 0.1 apart: each face is a
+    // Delaunay face only through a sphere bulging less than the nodes' clearance, centred far
+    // outside (it failed with all 12 triangles missing when the enclosing corners stood a
+    // quarter extent out).
+    let s = crate::common::cube_surface([0.0; 3], 1.0);
+    for h in [0.2, 0.1] {
+        let (mesh, report) = mesh_surface(
+            &s,
+            Sizing::uniform(h).unwrap(),
+            &PipelineOptions::default(),
+            &mut |_| {},
+        )
+        .unwrap();
+        assert_eq!(report.missing_triangles, 0, "h = {h}");
+        let c = check(&mesh, Some(&s));
+        assert!(c.valid, "h = {h}: {:?}", c.problems);
+        let v: f64 = (0..mesh.tets.len()).map(|t| volume(&mesh.corners(t))).sum();
+        assert!((v - 1.0).abs() < 1e-12, "h = {h}: volume {v}");
+        assert!(
+            mesh.tets.len() > (0.5 / (h * h * h)) as usize,
+            "h = {h}: {} tets",
+            mesh.tets.len()
+        );
+    }
+}
