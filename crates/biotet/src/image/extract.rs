@@ -148,8 +148,8 @@ pub fn make_manifold(img: &mut LabelImage) -> Vec<(u32, u32, usize)> {
             match single {
                 Some(n) => set(n, lab, img),
                 None => {
-                    for n in 0..8 {
-                        if m & (1 << n) == 0 && idx[n] != usize::MAX {
+                    for (n, &v) in idx.iter().enumerate() {
+                        if m & (1 << n) == 0 && v != usize::MAX {
                             set(n, lab, img);
                         }
                     }

@@ -38,7 +38,7 @@ pub enum ImageError {
     },
     /// The affine is not finite, not affine, or singular.
     #[error("voxel-to-world matrix {0:?} is not a finite invertible affine map")]
-    Affine([[f64; 4]; 4]),
+    Affine(Box<[[f64; 4]; 4]>),
 }
 
 impl LabelImage {
@@ -64,7 +64,7 @@ impl LabelImage {
         let finite = m.iter().flatten().all(|x| x.is_finite());
         let det = img.determinant();
         if !finite || m[3] != [0.0, 0.0, 0.0, 1.0] || det == 0.0 || !det.is_finite() {
-            return Err(ImageError::Affine(img.voxel_to_world));
+            return Err(ImageError::Affine(Box::new(img.voxel_to_world)));
         }
         Ok(img)
     }
