@@ -22,7 +22,11 @@
 //!   manifold, or gives its voxels there to the highest label. Every change raises a voxel's
 //!   rank, so the repair ends after at most (labels − 1) changes per voxel; it is counted in
 //!   [`ExtractReport::relabelled`]. Regions of different labels may touch at an edge or a
-//!   corner: `validate` and `check` accept that.
+//!   corner: `validate` and `check` accept that, as long as the outside is not pinched
+//!   there too — `check` reads a tet mesh's boundary as one surface whose pieces meeting only at
+//!   a point or an edge are separate; so, at every corner, each set of non-zero voxels joined
+//!   through faces must leave the other voxels connected, else its highest label grows over
+//!   the corner's outside voxels (again a rise in rank).
 //! - **Embedded.** Faces of the grid meet only in grid edges and corners, which are edges and
 //!   points of the triangulation.
 //! - **Volume.** Each region's surface encloses exactly its voxels' volume (after the repair).
@@ -91,6 +95,36 @@ fn block(img: &LabelImage, a: usize, b: usize, c: usize) -> ([u32; 8], [usize; 8
     (l, idx)
 }
 
+/// The outside (label 0) must be manifold too, as `check` reads a tet mesh's boundary: at a
+/// corner, each connected set of non-zero voxels (regions joined through faces) must leave the
+/// rest connected. Returns the highest label of the first set that does not, and the set's
+/// mask; growing that label over the corner's outside voxels repairs it.
+fn outside_pinch(l: &[u32; 8], ok: &[bool; 256]) -> Option<(u32, usize)> {
+    let mut done = 0usize;
+    for s in 0..8 {
+        if l[s] == 0 || done & (1 << s) != 0 {
+            continue;
+        }
+        let mut m = 1usize << s;
+        let mut stack = vec![s];
+        while let Some(c) = stack.pop() {
+            for bit in [1, 2, 4] {
+                let n = c ^ bit;
+                if l[n] != 0 && m & (1 << n) == 0 {
+                    m |= 1 << n;
+                    stack.push(n);
+                }
+            }
+        }
+        done |= m;
+        if !ok[m] {
+            let top = (0..8).filter(|&n| m & (1 << n) != 0).map(|n| l[n]).max();
+            return top.map(|t| (t, m));
+        }
+    }
+    None
+}
+
 /// Relabel voxels until every non-zero label is manifold at every grid corner (see the
 /// [module documentation](self)). Returns `(from, to, voxels)` for the changes, sorted.
 pub fn make_manifold(img: &mut LabelImage) -> Vec<(u32, u32, usize)> {
@@ -121,7 +155,9 @@ pub fn make_manifold(img: &mut LabelImage) -> Vec<(u32, u32, usize)> {
                 break;
             }
         }
-        let Some((lab, m)) = bad else { continue };
+        let Some((lab, m)) = bad.or_else(|| outside_pinch(&l, &ok)) else {
+            continue;
+        };
         let mut set = |n: usize, to: u32, img: &mut LabelImage| {
             let v = idx[n];
             *changes.entry((img.labels[v], to)).or_default() += 1;
@@ -140,26 +176,24 @@ pub fn make_manifold(img: &mut LabelImage) -> Vec<(u32, u32, usize)> {
                 }
             }
         };
+        // A pinched outside grows the pinching set's top label over outside voxels only.
+        let pinch = bad.is_none();
+        let top = if pinch { lab } else { top };
         if lab == top {
-            // Grow: the first single in-image voxel whose change makes the label manifold,
-            // else all of the block's in-image voxels.
-            let single =
-                (0..8).find(|&n| m & (1 << n) == 0 && idx[n] != usize::MAX && ok[m | (1 << n)]);
-            match single {
+            // Grow over lower labels: the first single in-image voxel whose change makes the
+            // set manifold, else all of the corner's in-image voxels it may take.
+            let may = |n: usize| m & (1 << n) == 0 && idx[n] != usize::MAX && (!pinch || l[n] == 0);
+            match (0..8).find(|&n| may(n) && ok[m | (1 << n)]) {
                 Some(n) => set(n, lab, img),
                 None => {
-                    for (n, &v) in idx.iter().enumerate() {
-                        if m & (1 << n) == 0 && v != usize::MAX {
-                            set(n, lab, img);
-                        }
+                    for n in (0..8).filter(|&n| may(n)) {
+                        set(n, lab, img);
                     }
                 }
             }
         } else {
-            for n in 0..8 {
-                if m & (1 << n) != 0 {
-                    set(n, top, img);
-                }
+            for n in (0..8).filter(|&n| m & (1 << n) != 0) {
+                set(n, top, img);
             }
         }
         // The corner itself may need more work.
