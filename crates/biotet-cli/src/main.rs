@@ -62,6 +62,8 @@ enum Command {
     Improve(cmd::improve::Args),
     /// Validate closed surfaces: closed, manifold, consistently oriented, no self-intersection.
     Validate(cmd::validate::Args),
+    /// Extract the labelled surface of a label image (NIfTI, MGH, NRRD, MetaImage, VTI).
+    SurfaceExtract(cmd::extract::Args),
 }
 
 /// Exit status when the input was read and judged invalid (a mesh that fails `check`, a surface
@@ -107,6 +109,7 @@ fn main() -> ExitCode {
         Command::Recover(a) => cmd::recover::run(a),
         Command::Improve(a) => cmd::improve::run(a),
         Command::Smooth(a) => cmd::smooth::run(a),
+        Command::SurfaceExtract(a) => cmd::extract::run(a),
     };
     match result {
         Ok(code) => code,

@@ -128,6 +128,8 @@ pub struct Args {
     #[arg(long, value_name = "FILE")]
     svg: Option<PathBuf>,
     #[command(flatten)]
+    image: super::extract::ImageArgs,
+    #[command(flatten)]
     common: Common,
 }
 
@@ -178,6 +180,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
     }
     let clock = Instant::now();
     let stage = Stage::start(a.common.quiet, "reading the surface");
+    let mut image = None;
     let (surface, shells, name) = if a.surfaces.is_empty() {
         let part = Part {
             surface: biotet_io::stl::parse(EXAMPLE, EXAMPLE_NAME)?.mesh,
@@ -186,6 +189,13 @@ pub fn run(a: Args) -> Result<ExitCode> {
         stage.set("validating the surface");
         let (s, sh) = super::input::assemble_parts(vec![part], EXAMPLE_NAME, &[], a.common)?;
         (s, sh, EXAMPLE_NAME.to_string())
+    } else if let [input] = &a.surfaces[..]
+        && biotet_io::is_label_image(input)
+    {
+        // A label image: its labelled surface (see `extract`), then the pipeline as for any.
+        let (s, summary) = super::extract::surface_from_image(input, &a.image, &stage)?;
+        image = Some(summary);
+        (s, Vec::new(), input.display().to_string())
     } else {
         super::input::labelled_surface(&a.surfaces, &a.label, a.common, &stage)?
     };
@@ -340,9 +350,14 @@ pub fn run(a: Args) -> Result<ExitCode> {
                 .map(|(stage, kb)| json!({"stage": stage, "peak_rss_kb": kb}))
                 .collect::<Vec<_>>(),
             "mesh_bytes": mesh.bytes(),
+            "image": image,
+            "image_regions": image.as_ref().map(|i| super::extract::region_volumes(i, &mesh)),
         }))?);
     } else if !a.common.quiet {
         let t = &report.template;
+        if let Some(i) = &image {
+            crate::emit(i.text().trim_end());
+        }
         let mut text = format!(
             "{name}: {} triangles → {} points, {} tets in {:.3} s\n\
              template: {} × {} × {} voxels at {:.4} ({:.1} MB, {} zones), {} surface and {} interior nodes\n",
@@ -391,6 +406,11 @@ pub fn run(a: Args) -> Result<ExitCode> {
             forcing.n_unforced_dihedral_lt_10,
             forcing.cause_text()
         );
+        if let Some(i) = &image {
+            text += "\n";
+            text +=
+                super::extract::region_text(&super::extract::region_volumes(i, &mesh)).trim_end();
+        }
         crate::emit(&text);
     }
     if let (Some(r), Some(note)) = (&report.recover, &failure_note) {
