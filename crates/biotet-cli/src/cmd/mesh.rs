@@ -200,6 +200,12 @@ pub fn run(a: Args) -> Result<ExitCode> {
         super::input::labelled_surface(&a.surfaces, &a.label, a.common, &stage)?
     };
     let seconds_read = clock.elapsed().as_secs_f64();
+    // Image labels are the image's values (FreeSurfer's 2035 stays 2035); the template holds
+    // small labels, so they are renumbered for meshing and put back after.
+    let mut surface = surface;
+    let compaction = image
+        .as_ref()
+        .map(|_| biotet::image::labels::Compaction::of_surface(&mut surface));
     // Restart the peak-memory count so it measures meshing, not reading and validating (Linux),
     // and keep one peak per stage.
     let mut peaks = StagePeaks::start("sizing");
@@ -230,6 +236,13 @@ pub fn run(a: Args) -> Result<ExitCode> {
     sizing.min_size = a.min_size;
     sizing.max_size = a.max_size;
     sizing.region_sizes = parse_region_sizes(&a.region_size)?;
+    if let Some(c) = &compaction {
+        for (l, _) in sizing.region_sizes.iter_mut() {
+            *l = c
+                .compact(*l)
+                .with_context(|| format!("--region-size: no region {l} in the image"))?;
+        }
+    }
     let sizing = Sizing::new(&surface, sizing).context("sizing")?;
     // Part of meshing: the surface-derived size is built from the surface here.
     let seconds_sizing = clock.elapsed().as_secs_f64();
@@ -263,12 +276,16 @@ pub fn run(a: Args) -> Result<ExitCode> {
     }
     // Each stage starts from what the previous ones left in use, not from their peaks. The sizing
     // goes in by value, to be freed after deployment.
-    let (mesh, report) = mesh_surface(&surface, sizing, &opts, &mut |s| {
+    let (mut mesh, report) = mesh_surface(&surface, sizing, &opts, &mut |s| {
         release_free_memory();
         peaks.next(Some(s));
         stage.set(s)
     })
     .with_context(|| name.clone())?;
+    if let Some(c) = &compaction {
+        c.restore_tets(&mut mesh);
+        c.restore_surface(&mut surface);
+    }
 
     release_free_memory();
     peaks.next(Some("measuring"));

@@ -264,6 +264,63 @@ fn merge_islands(img: &mut LabelImage, min: usize) -> Vec<MergedIsland> {
     merged
 }
 
+/// Image labels renumbered 1, 2, … for the mesher, whose template holds region labels up to
+/// [`crate::template::voxels::MAX_REGION`]; the image's own values are put back on the tets after
+/// meshing ([`Compaction::restore_tets`]). At most that many regions can be meshed.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Compaction {
+    /// `original[c]` is the image label of compact label `c` (`original[0] = 0`).
+    pub original: Vec<u32>,
+}
+
+impl Compaction {
+    /// Renumber a surface's labels in increasing order of value (0 stays 0).
+    pub fn of_surface(s: &mut crate::SurfaceMesh) -> Compaction {
+        let mut labels: Vec<u32> = s.sides.iter().flatten().copied().collect();
+        labels.push(0);
+        labels.sort_unstable();
+        labels.dedup();
+        let c = Compaction { original: labels };
+        for side in s.sides.iter_mut() {
+            for l in side.iter_mut() {
+                *l = c.compact(*l).expect("every label is listed");
+            }
+        }
+        c
+    }
+
+    /// The compact label of an image label.
+    pub fn compact(&self, label: u32) -> Option<u32> {
+        self.original.binary_search(&label).ok().map(|i| i as u32)
+    }
+
+    /// Whether the renumbering changes anything.
+    pub fn is_identity(&self) -> bool {
+        self.original
+            .iter()
+            .enumerate()
+            .all(|(i, &l)| i as u32 == l)
+    }
+
+    /// Put the image's labels back on a surface.
+    pub fn restore_surface(&self, s: &mut crate::SurfaceMesh) {
+        for side in s.sides.iter_mut() {
+            for l in side.iter_mut() {
+                *l = self.original[*l as usize];
+            }
+        }
+    }
+
+    /// Put the image's labels back on a tet mesh.
+    pub fn restore_tets(&self, m: &mut crate::TetMesh) {
+        for l in m.labels.iter_mut() {
+            if let Some(&o) = self.original.get(*l as usize) {
+                *l = o;
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -294,6 +351,21 @@ mod tests {
             ..Default::default()
         };
         assert_eq!(apply(&mut z, &o), Err(LabelError::ZeroNotOutside(1, 5)));
+    }
+
+    #[test]
+    fn compaction_round_trips() {
+        let mut s = crate::SurfaceMesh {
+            points: vec![],
+            triangles: vec![],
+            sides: vec![[41, 0], [17, 41], [2035, 17]],
+        };
+        let c = Compaction::of_surface(&mut s);
+        assert_eq!(s.sides, vec![[2, 0], [1, 2], [3, 1]]);
+        assert_eq!(c.compact(2035), Some(3));
+        assert!(!c.is_identity());
+        c.restore_surface(&mut s);
+        assert_eq!(s.sides, vec![[41, 0], [17, 41], [2035, 17]]);
     }
 
     #[test]
