@@ -244,12 +244,12 @@ pub fn region_text(rows: &[serde_json::Value]) -> String {
     for r in rows {
         t += &format!(
             "{:>6}  {:>10}  {:>13.6e}  {:>13.6e}  {:>+8.2e}  {:>8}\n",
-            r["label"],
-            r["voxels"],
+            r["label"].as_u64().unwrap_or(0),
+            r["voxels"].as_u64().unwrap_or(0),
             r["voxel_volume"].as_f64().unwrap_or(f64::NAN),
             r["mesh_volume"].as_f64().unwrap_or(f64::NAN),
             r["relative_error"].as_f64().unwrap_or(f64::NAN),
-            r["tets"],
+            r["tets"].as_u64().unwrap_or(0),
         );
     }
     t
