@@ -4,10 +4,10 @@
 use crate::{Common, progress::Stage};
 use anyhow::{Context, Result, bail};
 use biotet::SurfaceMesh;
-use biotet::TetMesh;
 use biotet::image::extract::{ExtractReport, extract};
 use biotet::image::labels::{LabelOptions, LabelReport, apply};
 use biotet::mesh::validate::{ValidateOptions, validate_surface};
+use biotet::quality::QualityReport;
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -213,26 +213,24 @@ impl ImageSummary {
     }
 }
 
-/// Per region: voxel volume beside the mesh's volume (and its relative error).
-pub fn region_volumes(summary: &ImageSummary, mesh: &TetMesh) -> Vec<serde_json::Value> {
-    let mut vol: std::collections::BTreeMap<u32, (f64, usize)> = Default::default();
-    for t in 0..mesh.tets.len() {
-        let e = vol.entry(mesh.labels[t]).or_default();
-        e.0 += biotet::quality::tet::volume(&mesh.corners(t));
-        e.1 += 1;
-    }
+/// Per region: voxel volume beside the mesh's volume (and its relative error), its tets and
+/// dihedral angle range.
+pub fn region_volumes(summary: &ImageSummary, quality: &QualityReport) -> Vec<serde_json::Value> {
     summary
         .regions
         .iter()
         .map(|r| {
-            let (m, n) = vol.get(&r.label).copied().unwrap_or_default();
+            let q = quality.regions.iter().find(|q| q.label == r.label);
+            let m = q.map_or(0.0, |q| q.volume);
             json!({
                 "label": r.label,
                 "voxels": r.voxels,
                 "voxel_volume": r.voxel_volume,
                 "mesh_volume": m,
                 "relative_error": (m - r.voxel_volume) / r.voxel_volume,
-                "tets": n,
+                "tets": q.map_or(0, |q| q.n_tets),
+                "min_dihedral_deg": q.map(|q| q.min_dihedral_deg),
+                "max_dihedral_deg": q.map(|q| q.max_dihedral_deg),
             })
         })
         .collect()
@@ -240,16 +238,20 @@ pub fn region_volumes(summary: &ImageSummary, mesh: &TetMesh) -> Vec<serde_json:
 
 /// Text table of [`region_volumes`].
 pub fn region_text(rows: &[serde_json::Value]) -> String {
-    let mut t = String::from("region  voxels      voxel volume   mesh volume    error     tets\n");
+    let mut t = String::from(
+        "region      voxels   voxel volume    mesh volume     error      tets  dihedral\n",
+    );
     for r in rows {
         t += &format!(
-            "{:>6}  {:>10}  {:>13.6e}  {:>13.6e}  {:>+8.2e}  {:>8}\n",
+            "{:>6}  {:>10}  {:>13.6e}  {:>13.6e}  {:>+8.1e}  {:>8}  {:.2}°–{:.2}°\n",
             r["label"].as_u64().unwrap_or(0),
             r["voxels"].as_u64().unwrap_or(0),
             r["voxel_volume"].as_f64().unwrap_or(f64::NAN),
             r["mesh_volume"].as_f64().unwrap_or(f64::NAN),
             r["relative_error"].as_f64().unwrap_or(f64::NAN),
             r["tets"].as_u64().unwrap_or(0),
+            r["min_dihedral_deg"].as_f64().unwrap_or(f64::NAN),
+            r["max_dihedral_deg"].as_f64().unwrap_or(f64::NAN),
         );
     }
     t

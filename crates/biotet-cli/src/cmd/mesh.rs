@@ -368,7 +368,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
                 .collect::<Vec<_>>(),
             "mesh_bytes": mesh.bytes(),
             "image": image,
-            "image_regions": image.as_ref().map(|i| super::extract::region_volumes(i, &mesh)),
+            "image_regions": image.as_ref().map(|i| super::extract::region_volumes(i, &quality)),
         }))?);
     } else if !a.common.quiet {
         let t = &report.template;
@@ -425,8 +425,8 @@ pub fn run(a: Args) -> Result<ExitCode> {
         );
         if let Some(i) = &image {
             text += "\n";
-            text +=
-                super::extract::region_text(&super::extract::region_volumes(i, &mesh)).trim_end();
+            text += super::extract::region_text(&super::extract::region_volumes(i, &quality))
+                .trim_end();
         }
         crate::emit(&text);
     }
