@@ -74,6 +74,11 @@ fn mesh_an_image_with_label_options() {
         let e = row["relative_error"].as_f64().unwrap();
         assert!(e.abs() < 1e-9, "{row}");
     }
+    // An oblique image is meshed in its axis-aligned frame, so flat voxel faces stay flat and
+    // no flat tet fills a rounding fold.
+    assert!(j["image"]["frame_to_world"].is_array());
+    let min = j["quality"]["min_dihedral_deg"].as_f64().unwrap();
+    assert!(min > 5.0, "min dihedral {min}");
     let c = biotet(&["check", s(&out), "--json"]);
     assert!(c.status.success(), "{}", stderr(&c));
     // Text output names the regions.

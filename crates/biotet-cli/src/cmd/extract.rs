@@ -75,6 +75,10 @@ pub struct ImageSummary {
     pub voxel_volume: f64,
     /// Voxel → world (RAS+).
     pub voxel_to_world: [[f64; 4]; 4],
+    /// For an oblique image, the frame → world map: the surface is extracted (and the mesh
+    /// made) in the image's axis-aligned frame, where voxel faces are exactly flat, and mapped
+    /// to world at the end (see `LabelImage::to_frame`). `None`: already axis-aligned.
+    pub frame_to_world: Option<[[f64; 4]; 4]>,
     /// The surface stage's default tolerance for this image (half the smallest spacing); the
     /// surface stage (issue 20) is not applied here.
     pub default_surface_tolerance: f64,
@@ -105,7 +109,8 @@ pub struct RegionVoxels {
     pub voxel_volume: f64,
 }
 
-/// Read an image, apply the label options, extract and validate the labelled surface.
+/// Read an image, apply the label options, extract and validate the labelled surface. The
+/// surface is in the image's frame: map it with [`ImageSummary::frame_to_world`] when set.
 pub fn surface_from_image(
     path: &Path,
     args: &ImageArgs,
@@ -119,6 +124,8 @@ pub fn surface_from_image(
     stage.set("applying labels");
     let labels = apply(&mut img, &args.options()?).with_context(|| path.display().to_string())?;
     let seconds_labels = clock.elapsed().as_secs_f64();
+    let voxel_to_world = img.voxel_to_world;
+    let frame_to_world = img.to_frame();
     let clock = Instant::now();
     stage.set("extracting the surface");
     let (mut surface, extract) = extract(&mut img);
@@ -150,7 +157,8 @@ pub fn surface_from_image(
         dims: img.dims,
         spacing: img.spacing(),
         voxel_volume: vv,
-        voxel_to_world: img.voxel_to_world,
+        voxel_to_world,
+        frame_to_world,
         default_surface_tolerance: img.default_surface_tolerance(),
         labels,
         extract,
@@ -284,6 +292,10 @@ pub fn run(a: Args) -> Result<ExitCode> {
     }
     let stage = Stage::start(a.common.quiet, "reading");
     let (surface, summary) = surface_from_image(&a.image, &a.image_args, &stage)?;
+    let mut surface = surface;
+    if let Some(m) = &summary.frame_to_world {
+        biotet::image::map_points(m, &mut surface.points);
+    }
     if let Some(out) = &a.output {
         stage.set(format!("writing {}", out.display()));
         biotet_io::write_surface(out, &surface)?;

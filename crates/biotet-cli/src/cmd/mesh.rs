@@ -224,8 +224,16 @@ pub fn run(a: Args) -> Result<ExitCode> {
                     path.display()
                 );
             }
+            // An oblique image is meshed in its frame: look the field up in world.
+            let to_world = image.as_ref().and_then(|i| i.frame_to_world);
             SizeSpec::Field {
-                size: Box::new(move |p| grid.value_at(p)),
+                size: Box::new(move |p| {
+                    let mut q = [p];
+                    if let Some(m) = &to_world {
+                        biotet::image::map_points(m, &mut q);
+                    }
+                    grid.value_at(q[0])
+                }),
                 min,
                 max,
             }
@@ -285,6 +293,11 @@ pub fn run(a: Args) -> Result<ExitCode> {
     if let Some(c) = &compaction {
         c.restore_tets(&mut mesh);
         c.restore_surface(&mut surface);
+    }
+    if let Some(m) = image.as_ref().and_then(|i| i.frame_to_world.as_ref()) {
+        // Meshed in the image's frame; a rotation (positive determinant) to world.
+        biotet::image::map_points(m, &mut mesh.points);
+        biotet::image::map_points(m, &mut surface.points);
     }
 
     release_free_memory();

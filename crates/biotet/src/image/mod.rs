@@ -14,6 +14,13 @@
 pub mod extract;
 pub mod labels;
 
+/// Apply an affine map (the last row `[0, 0, 0, 1]`) to points in place.
+pub fn map_points(m: &[[f64; 4]; 4], points: &mut [[f64; 3]]) {
+    for p in points.iter_mut() {
+        *p = std::array::from_fn(|r| m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3]);
+    }
+}
+
 /// A labelled 3D image: `labels[i + dims[0]·(j + dims[1]·k)]` is the label of voxel `(i, j, k)`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LabelImage {
@@ -139,6 +146,42 @@ impl LabelImage {
         0.5 * self.spacing().into_iter().fold(f64::INFINITY, f64::min)
     }
 
+    /// For an oblique image (a voxel-to-world map that is not a scaled permutation), split the
+    /// map into an axis-aligned *frame* and a frame → world map: sets `voxel_to_world` to
+    /// `diag(±spacing)` (no offset; x negated when the map reverses orientation) and returns
+    /// the map `M` with `world = M · frame`, whose linear part has positive
+    /// determinant (a rotation when the voxel axes are orthogonal). `None` when the map is
+    /// already axis-aligned.
+    ///
+    /// Why: the grid corners of one voxel face are exactly coplanar in an axis-aligned frame
+    /// (they share one coordinate), but not after a rotation in floating point, where the
+    /// staircase surface's flat parts become slightly folded and a mesher may fill the fold with
+    /// a flat tet. Meshing in the frame and mapping the mesh to world at the end keeps flat
+    /// parts flat and, the map being a rotation, every angle.
+    pub fn to_frame(&mut self) -> Option<[[f64; 4]; 4]> {
+        let m = self.voxel_to_world;
+        let aligned = (0..3).all(|c| (0..3).filter(|&r| m[r][c] != 0.0).count() == 1);
+        if aligned {
+            return None;
+        }
+        let s = self.spacing();
+        let sign = if self.determinant() < 0.0 { -1.0 } else { 1.0 };
+        let scale = [sign * s[0], s[1], s[2]];
+        let mut f = [[0.0; 4]; 4];
+        let mut to_world = [[0.0; 4]; 4];
+        for r in 0..3 {
+            f[r][r] = scale[r];
+            for c in 0..3 {
+                to_world[r][c] = m[r][c] / scale[c];
+            }
+            to_world[r][3] = m[r][3];
+        }
+        f[3][3] = 1.0;
+        to_world[3][3] = 1.0;
+        self.voxel_to_world = f;
+        Some(to_world)
+    }
+
     /// Voxels per label, sorted by label.
     pub fn counts(&self) -> Vec<(u32, usize)> {
         let mut m: rustc_hash::FxHashMap<u32, usize> = Default::default();
@@ -148,5 +191,34 @@ impl LabelImage {
         let mut v: Vec<(u32, usize)> = m.into_iter().collect();
         v.sort_unstable();
         v
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_then_world_is_the_image_map() {
+        let (c, s) = (0.6f64.cos(), 0.6f64.sin());
+        let m = [
+            [-c, -s * 1.5, 0.0, 10.0],
+            [-s, c * 1.5, 0.0, -3.0],
+            [0.0, 0.0, 0.75, 2.0],
+            [0.0, 0.0, 0.0, 1.0],
+        ];
+        let mut img = LabelImage::new([2, 2, 2], m, vec![1; 8]).unwrap();
+        let orig = img.clone();
+        let to_world = img.to_frame().unwrap();
+        let mut p = vec![img.world([0.5, -0.5, 1.5])];
+        map_points(&to_world, &mut p);
+        let want = orig.world([0.5, -0.5, 1.5]);
+        for r in 0..3 {
+            assert!((p[0][r] - want[r]).abs() < 1e-12);
+        }
+        assert!(img.determinant() < 0.0); // the frame keeps the orientation; M is a rotation
+        let lin = LabelImage::new([1, 1, 1], to_world, vec![0]).unwrap();
+        assert!((lin.determinant() - 1.0).abs() < 1e-12);
+        assert!(img.clone().to_frame().is_none());
     }
 }
