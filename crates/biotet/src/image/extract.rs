@@ -31,6 +31,11 @@
 //!   points of the triangulation.
 //! - **Volume.** Each region's surface encloses exactly its voxels' volume (after the repair).
 //!
+//! Points are in the image's world coordinates. For an oblique image (a rotated voxel grid) the
+//! corners of one flat face are then coplanar only up to rounding; to mesh, extract in the
+//! image's axis-aligned frame ([`LabelImage::to_frame`]) and map the mesh to world at the end
+//! ([`super::map_points`]), as `biotet mesh IMAGE` does.
+//!
 //! The surface is staircase-shaped; its smoothing belongs to the surface stage (issue 20:
 //! `surface::improve` within a tolerance, by default [`LabelImage::default_surface_tolerance`],
 //! half the smallest voxel spacing), which takes this [`SurfaceMesh`] as it takes any labelled

@@ -33,6 +33,8 @@ fn image(dims: [usize; 3], f: impl Fn(i64, i64, i64) -> u32) -> LabelImage {
 /// Extract, validate, mesh with the full pipeline, check, and compare region volumes with the
 /// voxel volumes (after the manifold repair).
 fn extract_and_mesh(mut img: LabelImage, size: f64) -> usize {
+    // Mesh in the image's axis-aligned frame (voxel faces exactly flat), map to world after.
+    let to_world = img.to_frame();
     let (mut s, rep) = extract(&mut img);
     let v = validate_surface(&mut s, &ValidateOptions::default()).unwrap_or_else(|e| panic!("{e}"));
     assert!(!v.flipped_inward);
@@ -50,9 +52,16 @@ fn extract_and_mesh(mut img: LabelImage, size: f64) -> usize {
         );
     }
     let sizing = Sizing::uniform(size).unwrap();
-    let (mesh, report) =
+    let (mut mesh, report) =
         mesh_surface(&s, &sizing, &PipelineOptions::default(), &mut |_| {}).unwrap();
     assert_eq!(report.recover.as_ref().unwrap().missing_after, 0);
+    if let Some(m) = &to_world {
+        biotet::image::map_points(m, &mut mesh.points);
+        biotet::image::map_points(m, &mut s.points);
+    }
+    let q = biotet::quality::QualityReport::of(&mesh);
+    let min = q.min_dihedral_deg.unwrap();
+    assert!(min > 5.0, "min dihedral {min}");
     let c = biotet::check::check(&mesh, Some(&s));
     assert!(
         c.valid,
