@@ -107,6 +107,11 @@ pub struct RegionVoxels {
     pub voxels: usize,
     /// `voxels × voxel volume`.
     pub voxel_volume: f64,
+    /// Its 6-connected components in the image (after the label options).
+    pub components_in_image: usize,
+    /// Its 6-connected components in what the surface encloses (after the manifold repair;
+    /// a region the repair split or lost shows here).
+    pub components: usize,
 }
 
 /// Read an image, apply the label options, extract and validate the labelled surface. The
@@ -142,7 +147,17 @@ pub fn surface_from_image(
         .with_context(|| format!("{}: the extracted surface", path.display()))?;
     let seconds_validate = clock.elapsed().as_secs_f64();
     let vv = img.voxel_volume();
-    let regions = img
+    let comps = biotet::image::labels::Components::of(&img);
+    let count_of = |v: &[(u32, usize)], l: u32| v.iter().find(|c| c.0 == l).map_or(0, |c| c.1);
+    let mut after: Vec<(u32, usize)> = Vec::new();
+    for c in comps.list.iter().filter(|c| c.label != 0) {
+        match after.iter_mut().find(|a| a.0 == c.label) {
+            Some(a) => a.1 += 1,
+            None => after.push((c.label, 1)),
+        }
+    }
+    drop(comps);
+    let mut regions: Vec<RegionVoxels> = img
         .counts()
         .into_iter()
         .filter(|c| c.0 != 0)
@@ -150,8 +165,23 @@ pub fn surface_from_image(
             label,
             voxels,
             voxel_volume: voxels as f64 * vv,
+            components_in_image: count_of(&labels.components, label),
+            components: count_of(&after, label),
         })
         .collect();
+    // A region the repair took whole is reported too, with no voxels.
+    for &(label, n) in &labels.components {
+        if !regions.iter().any(|r| r.label == label) {
+            regions.push(RegionVoxels {
+                label,
+                voxels: 0,
+                voxel_volume: 0.0,
+                components_in_image: n,
+                components: 0,
+            });
+        }
+    }
+    regions.sort_by_key(|r| r.label);
     let summary = ImageSummary {
         file: path.display().to_string(),
         dims: img.dims,
@@ -204,6 +234,15 @@ impl ImageSummary {
                 self.labels.islands.len(),
                 v
             );
+        }
+        for r in &self.regions {
+            if r.components != r.components_in_image {
+                t += &format!(
+                    "  warning: region {} has {} connected components after the manifold repair, \
+                     {} in the image ({} voxels now)\n",
+                    r.label, r.components, r.components_in_image, r.voxels
+                );
+            }
         }
         if !self.extract.relabelled.is_empty() {
             let v: Vec<String> = self
@@ -309,11 +348,11 @@ pub fn run(a: Args) -> Result<ExitCode> {
         }))?);
     } else if !a.common.quiet {
         let mut t = summary.text();
-        t += "region  voxels      voxel volume\n";
+        t += "region      voxels   voxel volume  components (in the image)\n";
         for r in &summary.regions {
             t += &format!(
-                "{:>6}  {:>10}  {:>13.6e}\n",
-                r.label, r.voxels, r.voxel_volume
+                "{:>6}  {:>10}  {:>13.6e}  {} ({})\n",
+                r.label, r.voxels, r.voxel_volume, r.components, r.components_in_image
             );
         }
         crate::emit(t.trim_end());

@@ -276,8 +276,17 @@ pub fn faces(img: &LabelImage) -> SurfaceMesh {
                     }
                     let q = QUADS[axis].map(|o| corner(i + o[0], j + o[1], k + o[2], &mut mesh));
                     let sides = if flip { [here, back] } else { [back, here] };
-                    mesh.triangles.push([q[0], q[1], q[2]]);
-                    mesh.triangles.push([q[0], q[2], q[3]]);
+                    // The diagonal away from the corner of highest index: the one the
+                    // Delaunay's symbolic perturbation picks for four cocircular points (the
+                    // highest index is perturbed most), so fewer triangles need recovery.
+                    let top = (0..4).max_by_key(|&c| q[c]).expect("4 corners");
+                    if top % 2 == 0 {
+                        mesh.triangles.push([q[0], q[1], q[3]]);
+                        mesh.triangles.push([q[1], q[2], q[3]]);
+                    } else {
+                        mesh.triangles.push([q[0], q[1], q[2]]);
+                        mesh.triangles.push([q[0], q[2], q[3]]);
+                    }
                     mesh.sides.push(sides);
                     mesh.sides.push(sides);
                 }
