@@ -19,7 +19,8 @@
 //!   [`make_manifold`] repairs them first by relabelling voxels, always to a label of higher
 //!   *rank* (rank = the label value, the outside 0 lowest): a label non-manifold at a corner
 //!   either is the highest label there and grows over the corner's other voxels until it is
-//!   manifold, or gives its voxels there to the highest label. Every change raises a voxel's
+//!   manifold, or gives its voxels there to the highest label (one voxel when one is enough,
+//!   in both cases). Every change raises a voxel's
 //!   rank, so the repair ends after at most (labels − 1) changes per voxel; it is counted in
 //!   [`ExtractReport::relabelled`]. Regions of different labels may touch at an edge or a
 //!   corner: `validate` and `check` accept that, as long as the outside is not pinched
@@ -197,8 +198,16 @@ pub fn make_manifold(img: &mut LabelImage) -> Vec<(u32, u32, usize)> {
                 }
             }
         } else {
-            for n in (0..8).filter(|&n| m & (1 << n) != 0) {
-                set(n, top, img);
+            // Give voxels to the highest label: the first single one that makes the label
+            // manifold here, else all of its voxels at the corner.
+            let mine = |n: usize| m & (1 << n) != 0;
+            match (0..8).find(|&n| mine(n) && ok[m & !(1 << n)]) {
+                Some(n) => set(n, top, img),
+                None => {
+                    for n in (0..8).filter(|&n| mine(n)) {
+                        set(n, top, img);
+                    }
+                }
             }
         }
         // The corner itself may need more work.
