@@ -65,6 +65,8 @@ enum Command {
     Remesh(cmd::remesh::Args),
     /// Validate closed surfaces: closed, manifold, consistently oriented, no self-intersection.
     Validate(cmd::validate::Args),
+    /// Extract the labelled surface of a label image (NIfTI, MGH, NRRD, MetaImage, VTI).
+    SurfaceExtract(cmd::extract::Args),
 }
 
 /// Exit status when the input was read and judged invalid (a mesh that fails `check`, a surface
@@ -111,6 +113,7 @@ fn main() -> ExitCode {
         Command::Improve(a) => cmd::improve::run(a),
         Command::Remesh(a) => cmd::remesh::run(a),
         Command::Smooth(a) => cmd::smooth::run(a),
+        Command::SurfaceExtract(a) => cmd::extract::run(a),
     };
     match result {
         Ok(code) => code,

@@ -152,7 +152,7 @@ fn build(
 }
 
 /// `dims[0]·dims[1]·dims[2]`, refused above [`MAX_GRID_SAMPLES`].
-fn sample_count(dims: [usize; 3], file: &str) -> Result<usize> {
+pub(crate) fn sample_count(dims: [usize; 3], file: &str) -> Result<usize> {
     dims[0]
         .checked_mul(dims[1])
         .and_then(|x| x.checked_mul(dims[2]))
@@ -535,15 +535,15 @@ pub fn parse_vti(data: &[u8], file: &str, array: Option<&str>) -> Result<ScalarG
 // NIfTI.
 
 /// The NIfTI header fields that matter here, from either version.
-struct NiftiHeader {
+pub(crate) struct NiftiHeader {
     dim: [i64; 8],
     datatype: i16,
     pixdim: [f64; 8],
     vox_offset: f64,
     scl_slope: f64,
     scl_inter: f64,
-    qform_code: i32,
-    sform_code: i32,
+    pub(crate) qform_code: i32,
+    pub(crate) sform_code: i32,
     quatern: [f64; 3],
     qoffset: [f64; 3],
     srow: [[f64; 4]; 3],
@@ -584,7 +584,7 @@ impl Fields<'_> {
 }
 
 /// Parse a NIfTI-1 or NIfTI-2 header from the first bytes of a file.
-fn nifti_header(h: &[u8], file: &str) -> Result<NiftiHeader> {
+pub(crate) fn nifti_header(h: &[u8], file: &str) -> Result<NiftiHeader> {
     if h.len() < 4 {
         return Err(Error::truncated(
             file,
@@ -709,14 +709,14 @@ fn nifti_type(code: i16) -> std::result::Result<(&'static str, usize), &'static 
 }
 
 /// What the header says about the voxels: grid dims, type, and where the data is.
-struct NiftiLayout {
-    dims: [usize; 3],
-    ty: (&'static str, usize),
-    offset: usize,
-    nbytes: usize,
+pub(crate) struct NiftiLayout {
+    pub(crate) dims: [usize; 3],
+    pub(crate) ty: (&'static str, usize),
+    pub(crate) offset: usize,
+    pub(crate) nbytes: usize,
 }
 
-fn nifti_layout(h: &NiftiHeader, file: &str) -> Result<NiftiLayout> {
+pub(crate) fn nifti_layout(h: &NiftiHeader, file: &str) -> Result<NiftiLayout> {
     let nd = h.dim[0];
     if !(1..=7).contains(&nd) {
         return Err(Error::format(
@@ -782,7 +782,7 @@ fn nifti_layout(h: &NiftiHeader, file: &str) -> Result<NiftiLayout> {
 }
 
 /// The affine (3×4, voxel → world) the header describes.
-fn nifti_affine(h: &NiftiHeader, file: &str) -> Result<[[f64; 4]; 3]> {
+pub(crate) fn nifti_affine(h: &NiftiHeader, file: &str) -> Result<[[f64; 4]; 3]> {
     if h.sform_code > 0 {
         return Ok(h.srow);
     }
@@ -856,7 +856,7 @@ fn nifti_affine(h: &NiftiHeader, file: &str) -> Result<[[f64; 4]; 3]> {
 }
 
 /// The voxel values, scaled.
-fn nifti_values(h: &NiftiHeader, l: &NiftiLayout, bytes: &[u8]) -> Vec<f64> {
+pub(crate) fn nifti_values(h: &NiftiHeader, l: &NiftiLayout, bytes: &[u8]) -> Vec<f64> {
     let size = l.ty.1;
     let (slope, inter) = if h.scl_slope.is_finite() && h.scl_slope != 0.0 {
         let i = if h.scl_inter.is_finite() {
@@ -945,7 +945,7 @@ pub fn parse_nifti(data: &[u8], file: &str) -> Result<ScalarGrid> {
 
 /// Decompress a gzipped NIfTI file: the header first, then exactly the bytes it announces (so
 /// a lying header or a compression bomb cannot make us allocate more than the data needs).
-fn gunzip_nifti(data: &[u8], file: &str) -> Result<Vec<u8>> {
+pub(crate) fn gunzip_nifti(data: &[u8], file: &str) -> Result<Vec<u8>> {
     let gz_err = |e: std::io::Error| Error::format(file, format!("gzip: {e}"));
     let mut dec = flate2::read::MultiGzDecoder::new(data);
     let mut out = Vec::new();

@@ -43,6 +43,7 @@ mod common;
 pub mod error;
 pub mod gmsh;
 pub mod grid;
+pub mod image;
 pub mod medit;
 pub mod obj;
 pub mod off;
@@ -59,6 +60,7 @@ mod vtu_out;
 
 pub use error::{Error, Result};
 pub use grid::{read_scalar_grid, read_scalar_grid_named};
+pub use image::{is_label_image, read_label_image};
 pub use points::read_points;
 pub use poly::{PslgRead, is_pslg, read_pslg};
 pub use tetgen::{TetgenFiles, TetgenOptions};

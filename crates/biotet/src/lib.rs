@@ -13,6 +13,7 @@ pub mod check2d;
 pub mod delaunay;
 pub mod delaunay2d;
 pub mod geom;
+pub mod image;
 pub mod lastresort;
 pub mod mesh;
 pub mod pipeline;

@@ -128,6 +128,8 @@ pub struct Args {
     #[arg(long, value_name = "FILE")]
     svg: Option<PathBuf>,
     #[command(flatten)]
+    image: super::extract::ImageArgs,
+    #[command(flatten)]
     common: Common,
 }
 
@@ -178,6 +180,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
     }
     let clock = Instant::now();
     let stage = Stage::start(a.common.quiet, "reading the surface");
+    let mut image = None;
     let (surface, shells, name) = if a.surfaces.is_empty() {
         let part = Part {
             surface: biotet_io::stl::parse(EXAMPLE, EXAMPLE_NAME)?.mesh,
@@ -186,10 +189,23 @@ pub fn run(a: Args) -> Result<ExitCode> {
         stage.set("validating the surface");
         let (s, sh) = super::input::assemble_parts(vec![part], EXAMPLE_NAME, &[], a.common)?;
         (s, sh, EXAMPLE_NAME.to_string())
+    } else if let [input] = &a.surfaces[..]
+        && biotet_io::is_label_image(input)
+    {
+        // A label image: its labelled surface (see `extract`), then the pipeline as for any.
+        let (s, summary) = super::extract::surface_from_image(input, &a.image, &stage)?;
+        image = Some(summary);
+        (s, Vec::new(), input.display().to_string())
     } else {
         super::input::labelled_surface(&a.surfaces, &a.label, a.common, &stage)?
     };
     let seconds_read = clock.elapsed().as_secs_f64();
+    // Image labels are the image's values (FreeSurfer's 2035 stays 2035); the template holds
+    // small labels, so they are renumbered for meshing and put back after.
+    let mut surface = surface;
+    let compaction = image
+        .as_ref()
+        .map(|_| biotet::image::labels::Compaction::of_surface(&mut surface));
     // Restart the peak-memory count so it measures meshing, not reading and validating (Linux),
     // and keep one peak per stage.
     let mut peaks = StagePeaks::start("sizing");
@@ -208,8 +224,16 @@ pub fn run(a: Args) -> Result<ExitCode> {
                     path.display()
                 );
             }
+            // An oblique image is meshed in its frame: look the field up in world.
+            let to_world = image.as_ref().and_then(|i| i.frame_to_world);
             SizeSpec::Field {
-                size: Box::new(move |p| grid.value_at(p)),
+                size: Box::new(move |p| {
+                    let mut q = [p];
+                    if let Some(m) = &to_world {
+                        biotet::image::map_points(m, &mut q);
+                    }
+                    grid.value_at(q[0])
+                }),
                 min,
                 max,
             }
@@ -220,6 +244,13 @@ pub fn run(a: Args) -> Result<ExitCode> {
     sizing.min_size = a.min_size;
     sizing.max_size = a.max_size;
     sizing.region_sizes = parse_region_sizes(&a.region_size)?;
+    if let Some(c) = &compaction {
+        for (l, _) in sizing.region_sizes.iter_mut() {
+            *l = c
+                .compact(*l)
+                .with_context(|| format!("--region-size: no region {l} in the image"))?;
+        }
+    }
     let sizing = Sizing::new(&surface, sizing).context("sizing")?;
     // Part of meshing: the surface-derived size is built from the surface here.
     let seconds_sizing = clock.elapsed().as_secs_f64();
@@ -253,12 +284,21 @@ pub fn run(a: Args) -> Result<ExitCode> {
     }
     // Each stage starts from what the previous ones left in use, not from their peaks. The sizing
     // goes in by value, to be freed after deployment.
-    let (mesh, report) = mesh_surface(&surface, sizing, &opts, &mut |s| {
+    let (mut mesh, report) = mesh_surface(&surface, sizing, &opts, &mut |s| {
         release_free_memory();
         peaks.next(Some(s));
         stage.set(s)
     })
     .with_context(|| name.clone())?;
+    if let Some(c) = &compaction {
+        c.restore_tets(&mut mesh);
+        c.restore_surface(&mut surface);
+    }
+    if let Some(m) = image.as_ref().and_then(|i| i.frame_to_world.as_ref()) {
+        // Meshed in the image's frame; a rotation (positive determinant) to world.
+        biotet::image::map_points(m, &mut mesh.points);
+        biotet::image::map_points(m, &mut surface.points);
+    }
 
     release_free_memory();
     peaks.next(Some("measuring"));
@@ -340,9 +380,14 @@ pub fn run(a: Args) -> Result<ExitCode> {
                 .map(|(stage, kb)| json!({"stage": stage, "peak_rss_kb": kb}))
                 .collect::<Vec<_>>(),
             "mesh_bytes": mesh.bytes(),
+            "image": image,
+            "image_regions": image.as_ref().map(|i| super::extract::region_volumes(i, &quality)),
         }))?);
     } else if !a.common.quiet {
         let t = &report.template;
+        if let Some(i) = &image {
+            crate::emit(i.text().trim_end());
+        }
         let mut text = format!(
             "{name}: {} triangles → {} points, {} tets in {:.3} s\n\
              template: {} × {} × {} voxels at {:.4} ({:.1} MB, {} zones), {} surface and {} interior nodes\n",
@@ -391,6 +436,11 @@ pub fn run(a: Args) -> Result<ExitCode> {
             forcing.n_unforced_dihedral_lt_10,
             forcing.cause_text()
         );
+        if let Some(i) = &image {
+            text += "\n";
+            text += super::extract::region_text(&super::extract::region_volumes(i, &quality))
+                .trim_end();
+        }
         crate::emit(&text);
     }
     if let (Some(r), Some(note)) = (&report.recover, &failure_note) {

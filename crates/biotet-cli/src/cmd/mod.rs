@@ -3,6 +3,7 @@
 pub mod check;
 pub mod convert;
 pub mod delaunay;
+pub mod extract;
 pub mod improve;
 pub mod input;
 pub mod mesh;

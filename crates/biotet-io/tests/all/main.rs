@@ -5,6 +5,7 @@ mod common;
 mod dispatch;
 mod external;
 mod grid;
+mod label_image;
 mod malformed;
 mod pslg;
 mod real_data;

@@ -4,6 +4,7 @@ mod check;
 mod common;
 mod delaunay;
 mod forced;
+mod image;
 mod lastresort;
 mod plane;
 mod polish;
