@@ -60,6 +60,8 @@ enum Command {
     Recover(cmd::recover::Args),
     /// Remove slivers by refilling their cavities (LAST RESORT); points and surface untouched.
     Improve(cmd::improve::Args),
+    /// Surface operations: `surface improve` remeshes a surface within a distance bound.
+    Surface(cmd::surface::Args),
     /// Validate closed surfaces: closed, manifold, consistently oriented, no self-intersection.
     Validate(cmd::validate::Args),
 }
@@ -107,6 +109,7 @@ fn main() -> ExitCode {
         Command::Recover(a) => cmd::recover::run(a),
         Command::Improve(a) => cmd::improve::run(a),
         Command::Smooth(a) => cmd::smooth::run(a),
+        Command::Surface(a) => cmd::surface::run(a),
     };
     match result {
         Ok(code) => code,

@@ -23,6 +23,7 @@ pub mod recover2d;
 pub mod sizing;
 pub mod sizing_grid;
 pub mod smooth;
+pub mod surface;
 pub mod template;
 
 pub use mesh::surface::SurfaceMesh;

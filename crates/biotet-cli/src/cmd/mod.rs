@@ -10,4 +10,5 @@ pub mod plane;
 pub mod quality;
 pub mod recover;
 pub mod smooth;
+pub mod surface;
 pub mod validate;
