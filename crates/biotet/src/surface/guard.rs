@@ -24,11 +24,17 @@ pub struct InputSamples {
 impl InputSamples {
     /// Sample `s` with grid step at most `spacing` on each triangle; cells of size `h`.
     pub fn new(s: &SurfaceMesh, spacing: f64, h: f64) -> InputSamples {
-        let mut seen: FxHashMap<([u64; 3], [u32; 2]), ()> = FxHashMap::default();
         let mut out = InputSamples {
             h,
             ..Default::default()
         };
+        let mut first = vec![u32::MAX; s.points.len()];
+        for (t, tri) in s.triangles.iter().enumerate().rev() {
+            for &v in tri {
+                first[v as usize] = t as u32;
+            }
+        }
+        let vt_first = |t: usize, k: usize| first[s.triangles[t][k] as usize] as usize;
         for t in 0..s.triangles.len() {
             let c = s.corners(t);
             let longest = (0..3)
@@ -41,8 +47,12 @@ impl InputSamples {
                     let k = n - i - j;
                     let w = [i as f64, j as f64, k as f64].map(|x| x / n as f64);
                     let p = [0, 1, 2].map(|a| w[0] * c[0][a] + w[1] * c[1][a] + w[2] * c[2][a]);
-                    // Samples on shared edges and corners once.
-                    if seen.insert((p.map(f64::to_bits), s.sides[t]), ()).is_some() {
+                    // A corner belongs to the first triangle that uses it (edge samples
+                    // are taken by both triangles of the edge, harmlessly).
+                    if (i == n && t > vt_first(t, 0))
+                        || (j == n && t > vt_first(t, 1))
+                        || (k == n && t > vt_first(t, 2))
+                    {
                         continue;
                     }
                     let id = out.pts.len() as u32;

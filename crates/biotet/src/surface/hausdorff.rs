@@ -46,7 +46,13 @@ pub struct Sided {
 }
 
 /// The one-sided distance from the triangles `tris` over `pts` (those with `alive[t]`, when
-/// given) to `to`. Triangles farther than `flag` are listed in [`Sided::far`].
+/// given) to `to`. Triangles farther than `flag` are listed in [`Sided::far`]. A triangle whose
+/// bound (sampled maximum plus covering radius) exceeds `limit` is sampled again with spacing
+/// `fine` (pass `limit = f64::INFINITY` for one pass). Samples proven (by the Lipschitz bound
+/// from the previous sample of their row) no farther than `floor` or than the maximum so far are
+/// not measured, so every distance reported is at least `floor`: pass 0 for exact values, or a
+/// lower bound of the answer to save time.
+#[allow(clippy::too_many_arguments)]
 pub fn one_sided(
     pts: &[P3],
     tris: &[[u32; 3]],
@@ -54,7 +60,10 @@ pub fn one_sided(
     alive: Option<&[bool]>,
     to: &PatchIndex,
     spacing: f64,
+    fine: f64,
+    limit: f64,
     flag: f64,
+    floor: f64,
 ) -> Sided {
     struct Per {
         max: f64,
@@ -86,30 +95,50 @@ pub fn one_sided(
                 .map(|k| dist2(c[k], c[(k + 1) % 3]))
                 .fold(0.0, f64::max)
                 .sqrt();
-            let n = ((longest / spacing).ceil() as usize).max(1);
-            let mut max = 0.0f64;
+            let mut n = ((longest / spacing).ceil() as usize).max(1);
+            let mut max = floor;
             let mut far: Option<Far> = None;
             let mut count = 0;
-            for i in 0..=n {
-                for j in 0..=n - i {
-                    let k = n - i - j;
-                    let w = [i as f64, j as f64, k as f64].map(|x| x / n as f64);
-                    let p = [0, 1, 2].map(|a| w[0] * c[0][a] + w[1] * c[1][a] + w[2] * c[2][a]);
-                    let Some(q) = bvh.closest(p) else { continue };
-                    let d = q.d2.sqrt();
-                    count += 1;
-                    if d > max {
-                        max = d;
-                        if d > flag {
-                            far = Some(Far {
-                                triangle: t as u32,
-                                point: p,
-                                distance: d,
-                                nearest: q.triangle,
-                            });
+            let fine_n = ((longest / fine).ceil() as usize).max(1);
+            'again: loop {
+                for i in 0..=n {
+                    // An upper bound on the distance at the previous sample of the row: the
+                    // distance is 1-Lipschitz, so a sample that cannot exceed the maximum so far
+                    // is not measured.
+                    let mut prev: Option<(P3, f64)> = None;
+                    for j in 0..=n - i {
+                        let k = n - i - j;
+                        let w = [i as f64, j as f64, k as f64].map(|x| x / n as f64);
+                        let p = [0, 1, 2].map(|a| w[0] * c[0][a] + w[1] * c[1][a] + w[2] * c[2][a]);
+                        count += 1;
+                        if let Some((pp, pd)) = prev {
+                            let ub = pd + dist2(p, pp).sqrt();
+                            if ub <= max {
+                                prev = Some((p, ub));
+                                continue;
+                            }
+                        }
+                        let Some(q) = bvh.closest(p) else { continue };
+                        let d = q.d2.sqrt();
+                        prev = Some((p, d));
+                        if d > max {
+                            max = d;
+                            if d > flag {
+                                far = Some(Far {
+                                    triangle: t as u32,
+                                    point: p,
+                                    distance: d,
+                                    nearest: q.triangle,
+                                });
+                            }
                         }
                     }
                 }
+                if max + longest / n as f64 / 3f64.sqrt() > limit && fine_n > n {
+                    n = fine_n;
+                    continue 'again;
+                }
+                break;
             }
             Per {
                 max,

@@ -48,7 +48,8 @@ pub struct SurfaceOptions {
     pub rounds: usize,
     /// The smallest triangle angle aimed at (degrees). Default 30°.
     pub target_angle_deg: f64,
-    /// Sample spacing of the final measure; default `tolerance / 4`.
+    /// Sample spacing of the final measure; default `tolerance / 2`, a quarter of that on the
+    /// triangles whose bound it does not prove within the tolerance.
     pub sample_spacing: Option<f64>,
 }
 
@@ -260,13 +261,13 @@ pub fn improve(
         }
         None => median_edge_length(surface),
     };
-    let spacing = opts.sample_spacing.unwrap_or(d / 4.0);
+    let spacing = opts.sample_spacing.unwrap_or(d / 2.0);
     let f = features::find(surface, opts.feature_angle_deg);
     let index = PatchIndex::new(&surface.points, &surface.triangles, &surface.sides, None);
     // The loop keeps its samples within 0.7 D; the dense measure then has room.
-    let samples = guard::InputSamples::new(surface, d, l);
+    let samples = guard::InputSamples::new(surface, d.max(l / 4.0), l);
     let mut r = remesh::Remesher::new(surface, &f, &index, &samples, l, 0.7 * d);
-    r.spacing = (0.5 * l).min(d);
+    r.spacing = (0.25 * l).max(d);
     r.target_angle = opts.target_angle_deg;
     let trace = std::env::var_os("BIOTET_SURFACE_TRACE").is_some();
     if trace {
@@ -293,7 +294,12 @@ pub fn improve(
         r.round();
         show(&r, "round");
     }
+    r.reject.clear();
     for _ in 0..3 {
+        if trace {
+            eprintln!("{:?}", r.reject);
+            r.reject.clear();
+        }
         if r.clean_up() == 0 {
             break;
         }
@@ -302,7 +308,9 @@ pub fn improve(
     }
     // Repair: split where the output strays farther than 0.8 D (working samples, coarser).
     let mut repair_rounds = 0;
-    let work_spacing = (d / 2.0).max(spacing);
+    let work_spacing = spacing;
+    r.repairing = true;
+    let mut last_far = usize::MAX;
     for _ in 0..10 {
         let out_index = PatchIndex::new(&r.pts, &r.tris, &r.sides, Some(&r.alive));
         let oi = hausdorff::one_sided(
@@ -312,6 +320,9 @@ pub fn improve(
             Some(&r.alive),
             &index,
             work_spacing,
+            work_spacing,
+            f64::INFINITY,
+            0.9 * d,
             0.8 * d,
         );
         let io = hausdorff::one_sided(
@@ -321,6 +332,9 @@ pub fn improve(
             None,
             &out_index,
             work_spacing,
+            work_spacing,
+            f64::INFINITY,
+            0.9 * d,
             0.8 * d,
         );
         if trace {
@@ -333,9 +347,11 @@ pub fn improve(
                 io.far.len()
             );
         }
-        if oi.far.is_empty() && io.far.is_empty() {
+        let n_far = oi.far.len() + io.far.len();
+        if n_far == 0 || n_far >= last_far {
             break;
         }
+        last_far = last_far.min(n_far);
         repair_rounds += 1;
         let mut targets: Vec<u32> = oi
             .far
@@ -361,24 +377,43 @@ pub fn improve(
 
     // The final measure, on the output as returned.
     let out_index = PatchIndex::new(&out.points, &out.triangles, &out.sides, None);
-    let oi = hausdorff::one_sided(
-        &out.points,
-        &out.triangles,
-        &out.sides,
-        None,
-        &index,
-        spacing,
-        f64::INFINITY,
-    );
-    let io = hausdorff::one_sided(
-        &surface.points,
-        &surface.triangles,
-        &surface.sides,
-        None,
-        &out_index,
-        spacing,
-        f64::INFINITY,
-    );
+    let measure = |floor: f64| {
+        let oi = hausdorff::one_sided(
+            &out.points,
+            &out.triangles,
+            &out.sides,
+            None,
+            &index,
+            spacing,
+            spacing / 4.0,
+            d,
+            f64::INFINITY,
+            floor,
+        );
+        let io = hausdorff::one_sided(
+            &surface.points,
+            &surface.triangles,
+            &surface.sides,
+            None,
+            &out_index,
+            spacing,
+            spacing / 4.0,
+            d,
+            f64::INFINITY,
+            floor,
+        );
+        (oi, io)
+    };
+    // First with the samples under D/2 left unmeasured; exactly if some sheet is below that.
+    let (mut oi, mut io) = measure(d / 2.0);
+    if oi
+        .per_sheet
+        .iter()
+        .chain(&io.per_sheet)
+        .any(|x| x.1 <= d / 2.0)
+    {
+        (oi, io) = measure(0.0);
+    }
     if oi.max > d || io.max > d {
         return Err(SurfaceError::Tolerance {
             tolerance: d,

@@ -81,8 +81,12 @@ pub struct Remesher<'a> {
     pub target_angle: f64,
     /// What was done.
     pub counts: OpCounts,
+    /// Repair mode: a projection may lower the smallest angle (the distance comes first).
+    pub repairing: bool,
     scratch: Vec<u32>,
     scratch2: Vec<u32>,
+    /// Debug.
+    pub reject: std::collections::BTreeMap<u32, usize>,
 }
 
 impl<'a> Remesher<'a> {
@@ -119,8 +123,10 @@ impl<'a> Remesher<'a> {
             spacing: l / 2.0,
             target_angle: 30.0,
             counts: OpCounts::default(),
+            repairing: false,
             scratch: Vec::new(),
             scratch2: Vec::new(),
+            reject: Default::default(),
         }
     }
 
@@ -205,7 +211,7 @@ impl<'a> Remesher<'a> {
             .map(|k| dist2(c[k], c[(k + 1) % 3]))
             .fold(0.0, f64::max)
             .sqrt();
-        let n = ((longest / self.spacing).ceil() as usize).clamp(2, 12);
+        let n = ((longest / self.spacing).ceil() as usize).clamp(2, 6);
         let t2 = self.tol * self.tol;
         for i in 0..=n {
             for j in 0..=n - i {
@@ -404,10 +410,14 @@ impl<'a> Remesher<'a> {
     /// Move point `v` to `x` if every check passes.
     pub fn try_move(&mut self, v: u32, x: P3) -> bool {
         if self.is_fixed(v) || x == self.pts[v as usize] {
-            return false;
+            return self.no(407);
         }
         let fan = self.vt[v as usize].clone();
-        let floor = self.worst_angle(&fan).min(self.target_angle);
+        let floor = if self.repairing {
+            0.0
+        } else {
+            self.worst_angle(&fan).min(self.target_angle)
+        };
         let old_normals: Vec<P3> = fan.iter().map(|&t| unit_normal(&self.corners(t))).collect();
         let new: Vec<([u32; 3], [P3; 3])> = fan
             .iter()
@@ -420,21 +430,21 @@ impl<'a> Remesher<'a> {
             })
             .collect();
         if !self.shape_ok(&new, &old_normals, floor) {
-            return false;
+            return self.no(423);
         }
         if !new
             .iter()
             .zip(&fan)
             .all(|((_, c), &t)| self.near_input(c, self.sides[t as usize]))
         {
-            return false;
+            return self.no(430);
         }
         let old_c: Vec<[P3; 3]> = fan.iter().map(|&t| self.corners(t)).collect();
         if !self.input_kept(&old_c, &new, &fan, self.sides[fan[0] as usize]) {
-            return false;
+            return self.no(434);
         }
         if self.crosses(&new, &fan) {
-            return false;
+            return self.no(437);
         }
         for &t in &fan {
             self.grid.remove(t);
@@ -451,10 +461,10 @@ impl<'a> Remesher<'a> {
     /// Split edge `ab` at its midpoint, then try to project the new point onto the input.
     pub fn split(&mut self, a: u32, b: u32) -> bool {
         if self.feature.contains(&key(a, b)) {
-            return false;
+            return self.no(454);
         }
         let Some((t1, t2, c, d)) = self.edge_pair(a, b) else {
-            return false;
+            return self.no(457);
         };
         let (pa, pb) = (self.pts[a as usize], self.pts[b as usize]);
         let m = scale(add(pa, pb), 0.5);
@@ -463,7 +473,7 @@ impl<'a> Remesher<'a> {
             .iter()
             .any(is_degenerate)
         {
-            return false;
+            return self.no(466);
         }
         let mi = self.pts.len() as u32;
         self.pts.push(m);
@@ -484,30 +494,30 @@ impl<'a> Remesher<'a> {
     /// Collapse edge `ab` by removing `a` (its triangles then use `b`), if every check passes.
     pub fn collapse(&mut self, a: u32, b: u32, max_len: f64) -> bool {
         if self.is_fixed(a) || self.feature.contains(&key(a, b)) {
-            return false;
+            return self.no(487);
         }
         let Some((t1, t2, c, d)) = self.edge_pair(a, b) else {
-            return false;
+            return self.no(490);
         };
         if c == d {
-            return false;
+            return self.no(493);
         }
         // Link condition: the common neighbours of a and b are c and d alone.
         let na = self.neighbours(a);
         let nb = self.neighbours(b);
         let common = na.iter().filter(|x| nb.binary_search(x).is_ok()).count();
         if common != 2 {
-            return false;
+            return self.no(500);
         }
         let (da, db) = (self.vt[a as usize].len(), self.vt[b as usize].len());
         if da + db < 7 || self.vt[c as usize].len() < 4 || self.vt[d as usize].len() < 4 {
-            return false;
+            return self.no(504);
         }
         let pb = self.pts[b as usize];
         let pa = self.pts[a as usize];
         let max2 = max_len * max_len;
         if na.iter().any(|&x| dist2(self.pts[x as usize], pb) > max2) {
-            return false;
+            return self.no(510);
         }
         let fan: Vec<u32> = self.vt[a as usize].clone();
         let kept: Vec<u32> = fan
@@ -528,14 +538,14 @@ impl<'a> Remesher<'a> {
             })
             .collect();
         if !self.shape_ok(&new, &old_normals, floor) {
-            return false;
+            return self.no(531);
         }
         if !new
             .iter()
             .zip(&kept)
             .all(|((_, c), &t)| self.near_input(c, self.sides[t as usize]))
         {
-            return false;
+            return self.no(538);
         }
         // The removed point lay on (or near) the input: the new fan must pass near it.
         let t2r = self.tol * self.tol;
@@ -543,14 +553,14 @@ impl<'a> Remesher<'a> {
             .iter()
             .any(|(_, c)| dist2(pa, closest_on_triangle(pa, c)) <= t2r)
         {
-            return false;
+            return self.no(546);
         }
         let old_c: Vec<[P3; 3]> = fan.iter().map(|&t| self.corners(t)).collect();
         if !self.input_kept(&old_c, &new, &fan, self.sides[t1 as usize]) {
-            return false;
+            return self.no(550);
         }
         if self.crosses(&new, &fan) {
-            return false;
+            return self.no(553);
         }
         self.kill(t1);
         self.kill(t2);
@@ -565,10 +575,10 @@ impl<'a> Remesher<'a> {
     /// and every check passes.
     pub fn flip(&mut self, a: u32, b: u32) -> bool {
         if self.feature.contains(&key(a, b)) {
-            return false;
+            return self.no(568);
         }
         let Some((t1, t2, c, d)) = self.edge_pair(a, b) else {
-            return false;
+            return self.no(571);
         };
         if c == d
             || self.sides[t1 as usize] != self.sides[t2 as usize]
@@ -576,7 +586,7 @@ impl<'a> Remesher<'a> {
             || self.vt[b as usize].len() < 4
             || self.has_edge(c, d)
         {
-            return false;
+            return self.no(579);
         }
         let p = |v: u32| self.pts[v as usize];
         let new = [
@@ -587,31 +597,31 @@ impl<'a> Remesher<'a> {
         let old_min = angles_deg(&old[0]).0.min(angles_deg(&old[1]).0);
         let new_min = angles_deg(&new[0].1).0.min(angles_deg(&new[1].1).0);
         if new_min <= old_min + 1e-9 {
-            return false;
+            return self.no(590);
         }
         let n_old = {
             let s = add(unit_normal(&old[0]), unit_normal(&old[1]));
             let l = norm(s);
             if l == 0.0 {
-                return false;
+                return self.no(596);
             }
             scale(s, 1.0 / l)
         };
         if !self.shape_ok(&new, &[n_old, n_old], 0.0) {
-            return false;
+            return self.no(601);
         }
         if dot(unit_normal(&new[0].1), unit_normal(&new[1].1)) < 0.5 {
-            return false;
+            return self.no(604);
         }
         let sides = self.sides[t1 as usize];
         if !new.iter().all(|(_, c)| self.near_input(c, sides)) {
-            return false;
+            return self.no(608);
         }
         if !self.input_kept(&old, &new, &[t1, t2], sides) {
-            return false;
+            return self.no(611);
         }
         if self.crosses(&new, &[t1, t2]) {
-            return false;
+            return self.no(614);
         }
         self.replace(t1, new[0].0);
         self.replace(t2, new[1].0);
@@ -623,7 +633,7 @@ impl<'a> Remesher<'a> {
     /// plane, then onto the input.
     pub fn relax(&mut self, v: u32) -> bool {
         if self.is_fixed(v) || self.vt[v as usize].is_empty() {
-            return false;
+            return self.no(626);
         }
         let nb = self.neighbours(v);
         let mut q = [0.0; 3];
@@ -635,7 +645,7 @@ impl<'a> Remesher<'a> {
         let n = self.vertex_normal(v);
         let q = sub(q, scale(n, dot(n, sub(q, p))));
         let Some(x) = self.project(v, q) else {
-            return false;
+            return self.no(638);
         };
         self.try_move(v, x)
     }
@@ -790,6 +800,11 @@ impl<'a> Remesher<'a> {
             .collect();
         e.sort_by(|x, y| y.0.total_cmp(&x.0));
         e.iter().any(|&(_, a, b)| self.split(a, b))
+    }
+
+    fn no(&mut self, code: u32) -> bool {
+        *self.reject.entry(code).or_default() += 1;
+        false
     }
 
     /// Number of triangles in the surface.
