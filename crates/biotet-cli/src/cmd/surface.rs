@@ -41,6 +41,10 @@ pub struct StageArgs {
     /// corners stay exactly); 0: none for its angle alone.
     #[arg(long, value_name = "DEG", default_value_t = 30.0)]
     pub feature_angle: f64,
+    /// Curvature-adapted edge lengths (shorter where the surface bends, down to half the edge
+    /// length); experimental.
+    #[arg(long)]
+    pub adaptive_size: bool,
     /// Remeshing rounds (split, collapse, flip, relax).
     #[arg(long, value_name = "N", default_value_t = 6)]
     pub surface_rounds: usize,
@@ -91,6 +95,7 @@ pub fn stage(
         edge_length,
         feature_angle_deg: s.feature_angle,
         rounds: s.surface_rounds,
+        adaptive: s.adaptive_size,
         ..Default::default()
     };
     Ok(improve(surface, &opts)?)

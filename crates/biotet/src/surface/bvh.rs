@@ -219,6 +219,41 @@ impl Bvh {
         (best.triangle != u32::MAX).then_some(best)
     }
 
+    /// Whether some triangle is within `sqrt(r2)` of `p` (stops at the first one found).
+    pub fn any_within(&self, p: P3, r2: f64) -> bool {
+        if self.nodes.is_empty() {
+            return false;
+        }
+        let mut stack: Vec<u32> = Vec::with_capacity(64);
+        stack.push(0);
+        while let Some(i) = stack.pop() {
+            let node = &self.nodes[i as usize];
+            if box_d2(p, node.lo, node.hi) > r2 {
+                continue;
+            }
+            if node.count > 0 {
+                for &k in &self.order[node.start as usize..(node.start + node.count) as usize] {
+                    if dist2(p, closest_on_triangle(p, &self.tris[k as usize])) <= r2 {
+                        return true;
+                    }
+                }
+            } else {
+                let l = i + 1;
+                let r = node.start;
+                let dl = box_d2(p, self.nodes[l as usize].lo, self.nodes[l as usize].hi);
+                let dr = box_d2(p, self.nodes[r as usize].lo, self.nodes[r as usize].hi);
+                if dl <= dr {
+                    stack.push(r);
+                    stack.push(l);
+                } else {
+                    stack.push(l);
+                    stack.push(r);
+                }
+            }
+        }
+        false
+    }
+
     /// The closest point to `p` (`None` only for an empty index).
     pub fn closest(&self, p: P3) -> Option<Closest> {
         self.closest_within(p, f64::INFINITY)

@@ -118,6 +118,11 @@ pub fn one_sided(
                                 continue;
                             }
                         }
+                        // Only a sample farther than the maximum so far matters.
+                        if bvh.any_within(p, max * max) {
+                            prev = Some((p, max));
+                            continue;
+                        }
                         let Some(q) = bvh.closest(p) else { continue };
                         let d = q.d2.sqrt();
                         prev = Some((p, d));
@@ -134,8 +139,10 @@ pub fn one_sided(
                         }
                     }
                 }
-                if max + longest / n as f64 / 3f64.sqrt() > limit && fine_n > n {
-                    n = fine_n;
+                // Refine just enough for the bound to prove the limit (if it can).
+                if max + longest / n as f64 / 3f64.sqrt() > limit && fine_n > n && max < limit {
+                    let need = (longest / ((limit - max) * 3f64.sqrt())).ceil() as usize;
+                    n = need.max(2 * n).min(fine_n);
                     continue 'again;
                 }
                 break;

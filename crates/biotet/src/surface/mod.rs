@@ -26,6 +26,7 @@ pub mod grid;
 pub mod guard;
 pub mod hausdorff;
 pub mod remesh;
+pub mod size;
 
 use std::time::Instant;
 
@@ -48,7 +49,12 @@ pub struct SurfaceOptions {
     pub rounds: usize,
     /// The smallest triangle angle aimed at (degrees). Default 30°.
     pub target_angle_deg: f64,
-    /// Sample spacing of the final measure; default `tolerance / 2`, a quarter of that on the
+    /// Curvature-adapted edge lengths (shorter where the surface bends, so the distance bound
+    /// does not block the shape); `edge_length` is then the longest. Default `false` (see
+    /// docs/method.md: on the marching-cubes test surfaces it doubles the triangles and the
+    /// repair of the distance bound does not yet always converge).
+    pub adaptive: bool,
+    /// Sample spacing of the final measure; default `tolerance`, an eighth of that on the
     /// triangles whose bound it does not prove within the tolerance.
     pub sample_spacing: Option<f64>,
 }
@@ -62,6 +68,7 @@ impl Default for SurfaceOptions {
             rounds: 6,
             target_angle_deg: 30.0,
             sample_spacing: None,
+            adaptive: false,
         }
     }
 }
@@ -261,16 +268,53 @@ pub fn improve(
         }
         None => median_edge_length(surface),
     };
-    let spacing = opts.sample_spacing.unwrap_or(d / 2.0);
+    let spacing = opts.sample_spacing.unwrap_or(d);
     let f = features::find(surface, opts.feature_angle_deg);
     let index = PatchIndex::new(&surface.points, &surface.triangles, &surface.sides, None);
     // The loop keeps its samples within 0.7 D; the dense measure then has room.
     let samples = guard::InputSamples::new(surface, d.max(l / 4.0), l);
-    let mut r = remesh::Remesher::new(surface, &f, &index, &samples, l, 0.7 * d);
+    let trace = std::env::var_os("BIOTET_SURFACE_TRACE").is_some();
+    let eps_k: f64 = std::env::var("BT_EPS")
+        .ok()
+        .and_then(|x| x.parse().ok())
+        .unwrap_or(0.7);
+    let min_k: f64 = std::env::var("BT_MINK")
+        .ok()
+        .and_then(|x| x.parse().ok())
+        .unwrap_or(2.0);
+    let point_size = if opts.adaptive {
+        size::point_sizes(surface, 0.7 * d, l / 2.0, l, 0.5)
+    } else {
+        vec![l; surface.points.len()]
+    };
+    let tri_size: Vec<f64> = surface
+        .triangles
+        .iter()
+        .map(|t| t.iter().map(|&v| point_size[v as usize]).fold(l, f64::min))
+        .collect();
+    let mut r = remesh::Remesher::new(
+        surface,
+        &f,
+        &index,
+        &samples,
+        &point_size,
+        &tri_size,
+        l,
+        0.7 * d,
+    );
     r.spacing = (0.25 * l).max(d);
     r.target_angle = opts.target_angle_deg;
-    let trace = std::env::var_os("BIOTET_SURFACE_TRACE").is_some();
     if trace {
+        let mut q = point_size.clone();
+        q.sort_by(f64::total_cmp);
+        let n = q.len();
+        eprintln!(
+            "sizes: 10% {:.2} 25% {:.2} 50% {:.2} 75% {:.2}",
+            q[n / 10],
+            q[n / 4],
+            q[n / 2],
+            q[3 * n / 4]
+        );
         eprintln!(
             "L {l:.3}, {} sharp, {} rim edges, {} input samples",
             f.n_sharp,
@@ -385,7 +429,7 @@ pub fn improve(
             None,
             &index,
             spacing,
-            spacing / 4.0,
+            spacing / 8.0,
             d,
             f64::INFINITY,
             floor,
@@ -397,20 +441,22 @@ pub fn improve(
             None,
             &out_index,
             spacing,
-            spacing / 4.0,
+            spacing / 8.0,
             d,
             f64::INFINITY,
             floor,
         );
         (oi, io)
     };
-    // First with the samples under D/2 left unmeasured; exactly if some sheet is below that.
-    let (mut oi, mut io) = measure(d / 2.0);
+    // First with the samples under 0.4 D left unmeasured (then a triangle whose samples are all
+    // under it is proven within 0.4 D + D/√3 < D by its coarse samples alone); exactly if some
+    // sheet is below that.
+    let (mut oi, mut io) = measure(0.4 * d);
     if oi
         .per_sheet
         .iter()
         .chain(&io.per_sheet)
-        .any(|x| x.1 <= d / 2.0)
+        .any(|x| x.1 <= 0.4 * d)
     {
         (oi, io) = measure(0.0);
     }

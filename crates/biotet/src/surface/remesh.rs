@@ -70,6 +70,9 @@ pub struct Remesher<'a> {
     feature: FxHashSet<(u32, u32)>,
     input: &'a PatchIndex,
     samples: &'a InputSamples,
+    tri_size: &'a [f64],
+    /// Target edge length per point.
+    pub size: Vec<f64>,
     grid: Grid,
     /// Target edge length.
     pub l: f64,
@@ -91,11 +94,14 @@ pub struct Remesher<'a> {
 
 impl<'a> Remesher<'a> {
     /// Start from `s` with its features, projecting onto `input`.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         s: &SurfaceMesh,
         f: &Features,
         input: &'a PatchIndex,
         samples: &'a InputSamples,
+        point_size: &[f64],
+        tri_size: &'a [f64],
         l: f64,
         tol: f64,
     ) -> Remesher<'a> {
@@ -117,6 +123,8 @@ impl<'a> Remesher<'a> {
             feature: f.edges.clone(),
             input,
             samples,
+            tri_size,
+            size: point_size.to_vec(),
             grid,
             l,
             tol,
@@ -218,7 +226,7 @@ impl<'a> Remesher<'a> {
                 let k = n - i - j;
                 let w = [i as f64, j as f64, k as f64].map(|x| x / n as f64);
                 let p = [0, 1, 2].map(|a| w[0] * c[0][a] + w[1] * c[1][a] + w[2] * c[2][a]);
-                if bvh.closest_within(p, t2).is_none() {
+                if !bvh.any_within(p, t2) {
                     return false;
                 }
             }
@@ -390,11 +398,18 @@ impl<'a> Remesher<'a> {
         t
     }
 
-    /// The closest point of the input sheet of `v`'s triangles to `p`.
-    fn project(&self, v: u32, p: P3) -> Option<P3> {
+    /// The closest point of the input sheet of `v`'s triangles to `p`, and the target size
+    /// there.
+    fn project(&self, v: u32, p: P3) -> Option<(P3, f64)> {
         let t = *self.vt[v as usize].first()?;
         let bvh = self.input.get(self.sides[t as usize])?;
-        Some(bvh.closest(p)?.point)
+        let q = bvh.closest(p)?;
+        Some((q.point, self.tri_size[q.triangle as usize]))
+    }
+
+    /// The target length of edge `ab`.
+    fn target(&self, a: u32, b: u32) -> f64 {
+        self.size[a as usize].min(self.size[b as usize])
     }
 
     fn vertex_normal(&self, v: u32) -> P3 {
@@ -479,20 +494,23 @@ impl<'a> Remesher<'a> {
         self.pts.push(m);
         self.vt.push(Vec::new());
         self.fixed.push(false);
+        self.size.push(self.target(a, b));
         let (s1, s2) = (self.sides[t1 as usize], self.sides[t2 as usize]);
         self.replace(t1, [a, mi, c]);
         self.add([mi, b, c], s1);
         self.replace(t2, [b, mi, d]);
         self.add([mi, a, d], s2);
         self.counts.splits += 1;
-        if let Some(x) = self.project(mi, m) {
-            self.try_move(mi, x);
+        if let Some((x, h)) = self.project(mi, m)
+            && self.try_move(mi, x)
+        {
+            self.size[mi as usize] = h;
         }
         true
     }
 
     /// Collapse edge `ab` by removing `a` (its triangles then use `b`), if every check passes.
-    pub fn collapse(&mut self, a: u32, b: u32, max_len: f64) -> bool {
+    pub fn collapse(&mut self, a: u32, b: u32, factor: f64) -> bool {
         if self.is_fixed(a) || self.feature.contains(&key(a, b)) {
             return self.no(487);
         }
@@ -515,8 +533,10 @@ impl<'a> Remesher<'a> {
         }
         let pb = self.pts[b as usize];
         let pa = self.pts[a as usize];
-        let max2 = max_len * max_len;
-        if na.iter().any(|&x| dist2(self.pts[x as usize], pb) > max2) {
+        if na.iter().any(|&x| {
+            let m = factor * self.target(b, x);
+            dist2(self.pts[x as usize], pb) > m * m
+        }) {
             return self.no(510);
         }
         let fan: Vec<u32> = self.vt[a as usize].clone();
@@ -644,10 +664,14 @@ impl<'a> Remesher<'a> {
         let p = self.pts[v as usize];
         let n = self.vertex_normal(v);
         let q = sub(q, scale(n, dot(n, sub(q, p))));
-        let Some(x) = self.project(v, q) else {
-            return self.no(638);
+        let Some((x, h)) = self.project(v, q) else {
+            return false;
         };
-        self.try_move(v, x)
+        let moved = self.try_move(v, x);
+        if moved {
+            self.size[v as usize] = h;
+        }
+        moved
     }
 
     /// The current edges `(a, b)`, `a < b`, sorted.
@@ -673,16 +697,21 @@ impl<'a> Remesher<'a> {
         dist2(self.pts[a as usize], self.pts[b as usize]).sqrt()
     }
 
+    /// Length of `ab` relative to its target.
+    fn rel(&self, a: u32, b: u32) -> f64 {
+        self.len(a, b) / self.target(a, b)
+    }
+
     /// One round of Botsch–Kobbelt: splits, collapses, flips, relaxation.
     pub fn round(&mut self) {
-        let hi = 4.0 / 3.0 * self.l;
-        let lo = 4.0 / 5.0 * self.l;
-        // Split long edges, longest first, until none is left (bounded).
+        let hi = 4.0 / 3.0;
+        let lo = 4.0 / 5.0;
+        // Split long edges (against their target), longest first, until none is left (bounded).
         for _ in 0..4 {
             let mut long: Vec<(f64, u32, u32)> = self
                 .edges()
                 .into_iter()
-                .map(|(a, b)| (self.len(a, b), a, b))
+                .map(|(a, b)| (self.rel(a, b), a, b))
                 .filter(|e| e.0 > hi)
                 .collect();
             if long.is_empty() {
@@ -690,7 +719,7 @@ impl<'a> Remesher<'a> {
             }
             long.sort_by(|x, y| y.0.total_cmp(&x.0).then((x.1, x.2).cmp(&(y.1, y.2))));
             for (_, a, b) in long {
-                if self.len(a, b) > hi {
+                if self.rel(a, b) > hi {
                     self.split(a, b);
                 }
             }
@@ -699,7 +728,7 @@ impl<'a> Remesher<'a> {
         let mut short: Vec<(f64, u32, u32)> = self
             .edges()
             .into_iter()
-            .map(|(a, b)| (self.len(a, b), a, b))
+            .map(|(a, b)| (self.rel(a, b), a, b))
             .filter(|e| e.0 < lo)
             .collect();
         short.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
@@ -707,7 +736,7 @@ impl<'a> Remesher<'a> {
             if self.vt[a as usize].is_empty()
                 || self.vt[b as usize].is_empty()
                 || !self.has_edge(a, b)
-                || self.len(a, b) >= lo
+                || self.rel(a, b) >= lo
             {
                 continue;
             }
@@ -741,7 +770,7 @@ impl<'a> Remesher<'a> {
     /// Work on the triangles whose smallest angle is below the target: flip their edges,
     /// collapse their shortest edge, split their longest one, relax their corners.
     pub fn clean_up(&mut self) -> usize {
-        let hi = 4.0 / 3.0 * self.l;
+        let hi = 4.0 / 3.0;
         let bad: Vec<u32> = (0..self.tris.len() as u32)
             .filter(|&t| {
                 self.alive[t as usize] && angles_deg(&self.corners(t)).0 < self.target_angle
@@ -771,7 +800,8 @@ impl<'a> Remesher<'a> {
                 let (_, a, b) = e[0];
                 ok = self.collapse(a, b, hi * 1.25) || self.collapse(b, a, hi * 1.25);
             }
-            if !ok {
+            // A cap (an angle over 120°): split the edge opposite it.
+            if !ok && angles_deg(&self.corners(t)).1 > 120.0 {
                 let (_, a, b) = e[2];
                 ok = self.split(a, b);
             }
