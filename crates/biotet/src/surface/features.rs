@@ -85,8 +85,8 @@ pub fn find(s: &SurfaceMesh, feature_angle_deg: f64) -> Features {
             vt[v as usize].push(t as u32);
         }
     }
-    for v in 0..np {
-        if !f.fixed[v] && !vt[v].is_empty() && !single_fan(s, v as u32, &vt[v]) {
+    for (v, tris) in vt.iter().enumerate() {
+        if !f.fixed[v] && !tris.is_empty() && !single_fan(s, v as u32, tris) {
             f.fixed[v] = true;
         }
     }

@@ -54,8 +54,9 @@ pub struct SurfaceOptions {
     /// docs/method.md: on the marching-cubes test surfaces it doubles the triangles and the
     /// repair of the distance bound does not yet always converge).
     pub adaptive: bool,
-    /// Sample spacing of the final measure; default `tolerance`, an eighth of that on the
-    /// triangles whose bound it does not prove within the tolerance.
+    /// Sample spacing of the final measure; default `tolerance` (at least a 32nd of the edge
+    /// length), an eighth of that on the triangles whose bound it does not prove within the
+    /// tolerance.
     pub sample_spacing: Option<f64>,
 }
 
@@ -268,20 +269,12 @@ pub fn improve(
         }
         None => median_edge_length(surface),
     };
-    let spacing = opts.sample_spacing.unwrap_or(d);
+    // At most about 32 samples along an edge of length L (a tiny D would ask for millions).
+    let spacing = opts.sample_spacing.unwrap_or(d.max(l / 32.0));
     let f = features::find(surface, opts.feature_angle_deg);
     let index = PatchIndex::new(&surface.points, &surface.triangles, &surface.sides, None);
-    // The loop keeps its samples within 0.7 D; the dense measure then has room.
+    // Input samples for the in→out guard, spaced D (at least a quarter edge length).
     let samples = guard::InputSamples::new(surface, d.max(l / 4.0), l);
-    let trace = std::env::var_os("BIOTET_SURFACE_TRACE").is_some();
-    let eps_k: f64 = std::env::var("BT_EPS")
-        .ok()
-        .and_then(|x| x.parse().ok())
-        .unwrap_or(0.7);
-    let min_k: f64 = std::env::var("BT_MINK")
-        .ok()
-        .and_then(|x| x.parse().ok())
-        .unwrap_or(2.0);
     let point_size = if opts.adaptive {
         size::point_sizes(surface, 0.7 * d, l / 2.0, l, 0.5)
     } else {
@@ -302,55 +295,22 @@ pub fn improve(
         l,
         0.7 * d,
     );
+    // The loop keeps its samples within 0.7 D; the final measure then has room.
     r.spacing = (0.25 * l).max(d);
     r.target_angle = opts.target_angle_deg;
-    if trace {
-        let mut q = point_size.clone();
-        q.sort_by(f64::total_cmp);
-        let n = q.len();
-        eprintln!(
-            "sizes: 10% {:.2} 25% {:.2} 50% {:.2} 75% {:.2}",
-            q[n / 10],
-            q[n / 4],
-            q[n / 2],
-            q[3 * n / 4]
-        );
-        eprintln!(
-            "L {l:.3}, {} sharp, {} rim edges, {} input samples",
-            f.n_sharp,
-            f.n_rim,
-            samples.pts.len()
-        );
-    }
-    let show = |r: &remesh::Remesher, what: &str| {
-        if trace {
-            let s = r.to_surface();
-            let (lo, hi, n) = angle_stats(&s, 30.0);
-            eprintln!(
-                "{what}: {:.2}s {} tris, min {lo:.2} max {hi:.2} below30 {n} {:?}",
-                clock.elapsed().as_secs_f64(),
-                s.triangles.len(),
-                r.counts
-            );
-        }
-    };
     for _ in 0..opts.rounds {
         r.round();
-        show(&r, "round");
     }
-    r.reject.clear();
-    for _ in 0..3 {
-        if trace {
-            eprintln!("{:?}", r.reject);
-            r.reject.clear();
-        }
+    // The clean-up may use a little more of the tolerance (the final measure has room).
+    r.tol = 0.8 * d;
+    for _ in 0..6 {
         if r.clean_up() == 0 {
             break;
         }
         r.flips();
-        show(&r, "clean");
     }
-    // Repair: split where the output strays farther than 0.8 D (working samples, coarser).
+    // Repair: split where the output strays farther than 0.9 D (samples spaced D), while the
+    // number of such places falls.
     let mut repair_rounds = 0;
     let work_spacing = spacing;
     r.repairing = true;
@@ -381,16 +341,6 @@ pub fn improve(
             0.9 * d,
             0.8 * d,
         );
-        if trace {
-            eprintln!(
-                "repair: {:.2}s out->in {:.3} ({} far), in->out {:.3} ({} far)",
-                clock.elapsed().as_secs_f64(),
-                oi.max,
-                oi.far.len(),
-                io.max,
-                io.far.len()
-            );
-        }
         let n_far = oi.far.len() + io.far.len();
         if n_far == 0 || n_far >= last_far {
             break;
@@ -540,3 +490,6 @@ pub fn improve(
     };
     Ok((out, report))
 }
+
+#[cfg(test)]
+mod tests;

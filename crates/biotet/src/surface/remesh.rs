@@ -88,8 +88,6 @@ pub struct Remesher<'a> {
     pub repairing: bool,
     scratch: Vec<u32>,
     scratch2: Vec<u32>,
-    /// Debug.
-    pub reject: std::collections::BTreeMap<u32, usize>,
 }
 
 impl<'a> Remesher<'a> {
@@ -134,7 +132,6 @@ impl<'a> Remesher<'a> {
             repairing: false,
             scratch: Vec::new(),
             scratch2: Vec::new(),
-            reject: Default::default(),
         }
     }
 
@@ -425,7 +422,7 @@ impl<'a> Remesher<'a> {
     /// Move point `v` to `x` if every check passes.
     pub fn try_move(&mut self, v: u32, x: P3) -> bool {
         if self.is_fixed(v) || x == self.pts[v as usize] {
-            return self.no(407);
+            return false;
         }
         let fan = self.vt[v as usize].clone();
         let floor = if self.repairing {
@@ -445,21 +442,21 @@ impl<'a> Remesher<'a> {
             })
             .collect();
         if !self.shape_ok(&new, &old_normals, floor) {
-            return self.no(423);
+            return false;
         }
         if !new
             .iter()
             .zip(&fan)
             .all(|((_, c), &t)| self.near_input(c, self.sides[t as usize]))
         {
-            return self.no(430);
+            return false;
         }
         let old_c: Vec<[P3; 3]> = fan.iter().map(|&t| self.corners(t)).collect();
         if !self.input_kept(&old_c, &new, &fan, self.sides[fan[0] as usize]) {
-            return self.no(434);
+            return false;
         }
         if self.crosses(&new, &fan) {
-            return self.no(437);
+            return false;
         }
         for &t in &fan {
             self.grid.remove(t);
@@ -476,10 +473,10 @@ impl<'a> Remesher<'a> {
     /// Split edge `ab` at its midpoint, then try to project the new point onto the input.
     pub fn split(&mut self, a: u32, b: u32) -> bool {
         if self.feature.contains(&key(a, b)) {
-            return self.no(454);
+            return false;
         }
         let Some((t1, t2, c, d)) = self.edge_pair(a, b) else {
-            return self.no(457);
+            return false;
         };
         let (pa, pb) = (self.pts[a as usize], self.pts[b as usize]);
         let m = scale(add(pa, pb), 0.5);
@@ -488,7 +485,7 @@ impl<'a> Remesher<'a> {
             .iter()
             .any(is_degenerate)
         {
-            return self.no(466);
+            return false;
         }
         let mi = self.pts.len() as u32;
         self.pts.push(m);
@@ -512,24 +509,24 @@ impl<'a> Remesher<'a> {
     /// Collapse edge `ab` by removing `a` (its triangles then use `b`), if every check passes.
     pub fn collapse(&mut self, a: u32, b: u32, factor: f64) -> bool {
         if self.is_fixed(a) || self.feature.contains(&key(a, b)) {
-            return self.no(487);
+            return false;
         }
         let Some((t1, t2, c, d)) = self.edge_pair(a, b) else {
-            return self.no(490);
+            return false;
         };
         if c == d {
-            return self.no(493);
+            return false;
         }
         // Link condition: the common neighbours of a and b are c and d alone.
         let na = self.neighbours(a);
         let nb = self.neighbours(b);
         let common = na.iter().filter(|x| nb.binary_search(x).is_ok()).count();
         if common != 2 {
-            return self.no(500);
+            return false;
         }
         let (da, db) = (self.vt[a as usize].len(), self.vt[b as usize].len());
         if da + db < 7 || self.vt[c as usize].len() < 4 || self.vt[d as usize].len() < 4 {
-            return self.no(504);
+            return false;
         }
         let pb = self.pts[b as usize];
         let pa = self.pts[a as usize];
@@ -537,7 +534,7 @@ impl<'a> Remesher<'a> {
             let m = factor * self.target(b, x);
             dist2(self.pts[x as usize], pb) > m * m
         }) {
-            return self.no(510);
+            return false;
         }
         let fan: Vec<u32> = self.vt[a as usize].clone();
         let kept: Vec<u32> = fan
@@ -558,14 +555,14 @@ impl<'a> Remesher<'a> {
             })
             .collect();
         if !self.shape_ok(&new, &old_normals, floor) {
-            return self.no(531);
+            return false;
         }
         if !new
             .iter()
             .zip(&kept)
             .all(|((_, c), &t)| self.near_input(c, self.sides[t as usize]))
         {
-            return self.no(538);
+            return false;
         }
         // The removed point lay on (or near) the input: the new fan must pass near it.
         let t2r = self.tol * self.tol;
@@ -573,14 +570,14 @@ impl<'a> Remesher<'a> {
             .iter()
             .any(|(_, c)| dist2(pa, closest_on_triangle(pa, c)) <= t2r)
         {
-            return self.no(546);
+            return false;
         }
         let old_c: Vec<[P3; 3]> = fan.iter().map(|&t| self.corners(t)).collect();
         if !self.input_kept(&old_c, &new, &fan, self.sides[t1 as usize]) {
-            return self.no(550);
+            return false;
         }
         if self.crosses(&new, &fan) {
-            return self.no(553);
+            return false;
         }
         self.kill(t1);
         self.kill(t2);
@@ -595,10 +592,10 @@ impl<'a> Remesher<'a> {
     /// and every check passes.
     pub fn flip(&mut self, a: u32, b: u32) -> bool {
         if self.feature.contains(&key(a, b)) {
-            return self.no(568);
+            return false;
         }
         let Some((t1, t2, c, d)) = self.edge_pair(a, b) else {
-            return self.no(571);
+            return false;
         };
         if c == d
             || self.sides[t1 as usize] != self.sides[t2 as usize]
@@ -606,7 +603,7 @@ impl<'a> Remesher<'a> {
             || self.vt[b as usize].len() < 4
             || self.has_edge(c, d)
         {
-            return self.no(579);
+            return false;
         }
         let p = |v: u32| self.pts[v as usize];
         let new = [
@@ -617,31 +614,31 @@ impl<'a> Remesher<'a> {
         let old_min = angles_deg(&old[0]).0.min(angles_deg(&old[1]).0);
         let new_min = angles_deg(&new[0].1).0.min(angles_deg(&new[1].1).0);
         if new_min <= old_min + 1e-9 {
-            return self.no(590);
+            return false;
         }
         let n_old = {
             let s = add(unit_normal(&old[0]), unit_normal(&old[1]));
             let l = norm(s);
             if l == 0.0 {
-                return self.no(596);
+                return false;
             }
             scale(s, 1.0 / l)
         };
         if !self.shape_ok(&new, &[n_old, n_old], 0.0) {
-            return self.no(601);
+            return false;
         }
         if dot(unit_normal(&new[0].1), unit_normal(&new[1].1)) < 0.5 {
-            return self.no(604);
+            return false;
         }
         let sides = self.sides[t1 as usize];
         if !new.iter().all(|(_, c)| self.near_input(c, sides)) {
-            return self.no(608);
+            return false;
         }
         if !self.input_kept(&old, &new, &[t1, t2], sides) {
-            return self.no(611);
+            return false;
         }
         if self.crosses(&new, &[t1, t2]) {
-            return self.no(614);
+            return false;
         }
         self.replace(t1, new[0].0);
         self.replace(t2, new[1].0);
@@ -653,7 +650,7 @@ impl<'a> Remesher<'a> {
     /// plane, then onto the input.
     pub fn relax(&mut self, v: u32) -> bool {
         if self.is_fixed(v) || self.vt[v as usize].is_empty() {
-            return self.no(626);
+            return false;
         }
         let nb = self.neighbours(v);
         let mut q = [0.0; 3];
@@ -796,8 +793,10 @@ impl<'a> Remesher<'a> {
                     break;
                 }
             }
-            if !ok {
-                let (_, a, b) = e[0];
+            for &(_, a, b) in &e {
+                if ok {
+                    break;
+                }
                 ok = self.collapse(a, b, hi * 1.25) || self.collapse(b, a, hi * 1.25);
             }
             // A cap (an angle over 120°): split the edge opposite it.
@@ -830,11 +829,6 @@ impl<'a> Remesher<'a> {
             .collect();
         e.sort_by(|x, y| y.0.total_cmp(&x.0));
         e.iter().any(|&(_, a, b)| self.split(a, b))
-    }
-
-    fn no(&mut self, code: u32) -> bool {
-        *self.reject.entry(code).or_default() += 1;
-        false
     }
 
     /// Number of triangles in the surface.
