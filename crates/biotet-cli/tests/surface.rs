@@ -14,7 +14,11 @@ fn uv_sphere_off(r: f64, nu: usize, nv: usize) -> String {
         let th = std::f64::consts::PI * i as f64 / nv as f64;
         for j in 0..nu {
             let ph = 2.0 * std::f64::consts::PI * j as f64 / nu as f64;
-            p.push([r * th.sin() * ph.cos(), r * th.sin() * ph.sin(), r * th.cos()]);
+            p.push([
+                r * th.sin() * ph.cos(),
+                r * th.sin() * ph.sin(),
+                r * th.cos(),
+            ]);
         }
     }
     p.push([0.0, 0.0, -r]);
@@ -27,7 +31,12 @@ fn uv_sphere_off(r: f64, nu: usize, nv: usize) -> String {
     }
     for i in 1..nv - 1 {
         for j in 0..nu {
-            let (a, b, c, d) = (ring(i, j), ring(i, j + 1), ring(i + 1, j), ring(i + 1, j + 1));
+            let (a, b, c, d) = (
+                ring(i, j),
+                ring(i, j + 1),
+                ring(i + 1, j),
+                ring(i + 1, j + 1),
+            );
             t.push([a, c, d]);
             t.push([a, d, b]);
         }
@@ -120,7 +129,10 @@ fn surface_improve_help_has_an_example() {
     let out = biotet(&["surface", "improve", "--help"]);
     assert!(out.status.success());
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(text.contains("--tolerance") && text.contains("Examples"), "{text}");
+    assert!(
+        text.contains("--tolerance") && text.contains("Examples"),
+        "{text}"
+    );
     let out = biotet(&["mesh", "--help"]);
     assert!(String::from_utf8_lossy(&out.stdout).contains("--surface-tolerance"));
 }

@@ -31,7 +31,12 @@ pub fn uv_sphere(r: f64, c: [f64; 3], nu: usize, nv: usize) -> SurfaceMesh {
     }
     for i in 1..nv - 1 {
         for j in 0..nu {
-            let (a, b, c2, d) = (ring(i, j), ring(i, j + 1), ring(i + 1, j), ring(i + 1, j + 1));
+            let (a, b, c2, d) = (
+                ring(i, j),
+                ring(i, j + 1),
+                ring(i + 1, j),
+                ring(i + 1, j + 1),
+            );
             t.push([a, c2, d]);
             t.push([a, d, b]);
         }
