@@ -63,6 +63,8 @@ enum Command {
     /// Remesh part of a tet mesh in place: one region, or the tets meeting a box or a sphere,
     /// at a new size; every other tet kept exactly.
     Remesh(cmd::remesh::Args),
+    /// Surface operations: `surface improve` remeshes a surface within a distance bound.
+    Surface(cmd::surface::Args),
     /// Validate closed surfaces: closed, manifold, consistently oriented, no self-intersection.
     Validate(cmd::validate::Args),
     /// Extract the labelled surface of a label image (NIfTI, MGH, NRRD, MetaImage, VTI).
@@ -114,6 +116,7 @@ fn main() -> ExitCode {
         Command::Remesh(a) => cmd::remesh::run(a),
         Command::Smooth(a) => cmd::smooth::run(a),
         Command::SurfaceExtract(a) => cmd::extract::run(a),
+        Command::Surface(a) => cmd::surface::run(a),
     };
     match result {
         Ok(code) => code,

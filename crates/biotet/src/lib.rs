@@ -25,6 +25,7 @@ pub mod remesh;
 pub mod sizing;
 pub mod sizing_grid;
 pub mod smooth;
+pub mod surface;
 pub mod template;
 
 pub use mesh::surface::SurfaceMesh;

@@ -124,6 +124,17 @@ pub struct Args {
     /// template nodes.
     #[arg(long)]
     no_deploy: bool,
+    /// Before node deployment, remesh the surface to well-shaped triangles within this
+    /// two-sided (Hausdorff) distance D of the input (see `biotet surface improve --help`); the
+    /// improved surface is then kept exactly. The edge length is --size, else the input's
+    /// median edge length. Off by default: the input surface is kept exactly.
+    #[arg(long, value_name = "D")]
+    surface_tolerance: Option<f64>,
+    /// Where --surface-tolerance writes the improved surface (.ply keeps the region labels).
+    #[arg(long, value_name = "FILE", requires = "surface_tolerance")]
+    surface_output: Option<PathBuf>,
+    #[command(flatten)]
+    surface_stage: super::surface::StageArgs,
     /// Draw the output's dihedral- and solid-angle histograms to this SVG.
     #[arg(long, value_name = "FILE")]
     svg: Option<PathBuf>,
@@ -206,6 +217,19 @@ pub fn run(a: Args) -> Result<ExitCode> {
     let compaction = image
         .as_ref()
         .map(|_| biotet::image::labels::Compaction::of_surface(&mut surface));
+    // The opt-in surface stage: the improved surface replaces the input from here on.
+    let (mut surface, surface_report) = match a.surface_tolerance {
+        None => (surface, None),
+        Some(d) => {
+            stage.set("improving the surface");
+            let (s, r) = super::surface::stage(&surface, d, a.size, &a.surface_stage)
+                .with_context(|| name.clone())?;
+            if let Some(path) = &a.surface_output {
+                biotet_io::write_surface(path, &s)?;
+            }
+            (s, Some(r))
+        }
+    };
     // Restart the peak-memory count so it measures meshing, not reading and validating (Linux),
     // and keep one peak per stage.
     let mut peaks = StagePeaks::start("sizing");
@@ -360,7 +384,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
     peaks.next(None);
     let peak_kb = peaks.max();
     if a.common.json {
-        crate::emit(&serde_json::to_string_pretty(&json!({
+        let mut v = json!({
             "input": name,
             "output": a.output,
             "written": written,
@@ -382,7 +406,11 @@ pub fn run(a: Args) -> Result<ExitCode> {
             "mesh_bytes": mesh.bytes(),
             "image": image,
             "image_regions": image.as_ref().map(|i| super::extract::region_volumes(i, &quality)),
-        }))?);
+        });
+        if let Some(r) = &surface_report {
+            v["surface"] = serde_json::to_value(r)?;
+        }
+        crate::emit(&serde_json::to_string_pretty(&v)?);
     } else if !a.common.quiet {
         let t = &report.template;
         if let Some(i) = &image {
@@ -407,6 +435,10 @@ pub fn run(a: Args) -> Result<ExitCode> {
             report.n_surface_points,
             report.n_interior_nodes,
         );
+        if let Some(r) = &surface_report {
+            text += &super::surface::report_text(r);
+            text.push('\n');
+        }
         for s in &report.stages {
             text += &format!("  {:<22} {:.3} s\n", s.name, s.seconds);
         }

@@ -12,4 +12,5 @@ pub mod quality;
 pub mod recover;
 pub mod remesh;
 pub mod smooth;
+pub mod surface;
 pub mod validate;

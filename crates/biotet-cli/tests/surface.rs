@@ -1,0 +1,138 @@
+//! `biotet surface improve` and `biotet mesh --surface-tolerance` end to end, on a
+//! latitude–longitude sphere (needles at the poles): within the tolerance both ways, better
+//! angles, and a mesh that `biotet check` accepts against the improved surface.
+
+mod support;
+use std::fmt::Write as _;
+use std::path::Path;
+use support::*;
+
+/// A latitude–longitude sphere as OFF text.
+fn uv_sphere_off(r: f64, nu: usize, nv: usize) -> String {
+    let mut p = vec![[0.0, 0.0, r]];
+    for i in 1..nv {
+        let th = std::f64::consts::PI * i as f64 / nv as f64;
+        for j in 0..nu {
+            let ph = 2.0 * std::f64::consts::PI * j as f64 / nu as f64;
+            p.push([
+                r * th.sin() * ph.cos(),
+                r * th.sin() * ph.sin(),
+                r * th.cos(),
+            ]);
+        }
+    }
+    p.push([0.0, 0.0, -r]);
+    let south = p.len() - 1;
+    let ring = |i: usize, j: usize| 1 + (i - 1) * nu + j % nu;
+    let mut t = Vec::new();
+    for j in 0..nu {
+        t.push([0, ring(1, j), ring(1, j + 1)]);
+        t.push([south, ring(nv - 1, j + 1), ring(nv - 1, j)]);
+    }
+    for i in 1..nv - 1 {
+        for j in 0..nu {
+            let (a, b, c, d) = (
+                ring(i, j),
+                ring(i, j + 1),
+                ring(i + 1, j),
+                ring(i + 1, j + 1),
+            );
+            t.push([a, c, d]);
+            t.push([a, d, b]);
+        }
+    }
+    let mut s = format!("OFF\n{} {} 0\n", p.len(), t.len());
+    for q in &p {
+        writeln!(s, "{} {} {}", q[0], q[1], q[2]).unwrap();
+    }
+    for x in &t {
+        writeln!(s, "3 {} {} {}", x[0], x[1], x[2]).unwrap();
+    }
+    s
+}
+
+fn write_sphere(dir: &Path) -> std::path::PathBuf {
+    let path = dir.join("sphere.off");
+    std::fs::write(&path, uv_sphere_off(10.0, 24, 12)).unwrap();
+    path
+}
+
+#[test]
+fn surface_improve_keeps_the_tolerance_and_raises_the_angles() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = write_sphere(dir.path());
+    let out = dir.path().join("improved.ply");
+    let j = json_of(&biotet(&[
+        "surface",
+        "improve",
+        s(&input),
+        "--tolerance",
+        "0.3",
+        "-o",
+        s(&out),
+        "--json",
+    ]));
+    let r = &j["surface"];
+    for key in [
+        "hausdorff_in_to_out",
+        "hausdorff_out_to_in",
+        "hausdorff_bound",
+        "regions",
+        "min_angle_in",
+        "min_angle_out",
+        "triangles_in",
+        "triangles_out",
+        "seconds",
+    ] {
+        assert!(!r[key].is_null(), "{key} missing: {r}");
+    }
+    assert!(r["hausdorff_in_to_out"].as_f64().unwrap() <= 0.3);
+    assert!(r["hausdorff_out_to_in"].as_f64().unwrap() <= 0.3);
+    assert!(r["min_angle_out"].as_f64().unwrap() > r["min_angle_in"].as_f64().unwrap() + 10.0);
+    // The written surface is valid.
+    let v = biotet(&["validate", s(&out)]);
+    assert!(v.status.success(), "{}", stderr(&v));
+    // A hopeless option fails clearly.
+    let bad = biotet(&["surface", "improve", s(&input), "--tolerance", "-1"]);
+    assert!(!bad.status.success());
+    assert!(stderr(&bad).contains("tolerance"), "{}", stderr(&bad));
+}
+
+#[test]
+fn mesh_with_surface_tolerance_passes_check_against_the_improved_surface() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = write_sphere(dir.path());
+    let surf = dir.path().join("improved.ply");
+    let mesh = dir.path().join("m.vtu");
+    let j = json_of(&biotet(&[
+        "mesh",
+        s(&input),
+        "--surface-tolerance",
+        "0.3",
+        "--surface-output",
+        s(&surf),
+        "-o",
+        s(&mesh),
+        "--json",
+    ]));
+    assert!(j["surface"]["hausdorff_out_to_in"].as_f64().unwrap() <= 0.3);
+    assert_eq!(j["pipeline"]["missing_triangles"].as_u64(), Some(0));
+    let c = biotet(&["check", "--surface", s(&surf), s(&mesh)]);
+    assert!(c.status.success(), "{}", stderr(&c));
+    // Without the option, no surface section.
+    let plain = json_of(&biotet(&["mesh", s(&input), "--json"]));
+    assert!(plain.get("surface").is_none());
+}
+
+#[test]
+fn surface_improve_help_has_an_example() {
+    let out = biotet(&["surface", "improve", "--help"]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("--tolerance") && text.contains("Examples"),
+        "{text}"
+    );
+    let out = biotet(&["mesh", "--help"]);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("--surface-tolerance"));
+}

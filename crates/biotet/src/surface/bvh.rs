@@ -1,0 +1,393 @@
+//! A closest-point index over a fixed set of triangles: a bounding-volume hierarchy (median
+//! split on the longest axis of the centroids' box, leaves of a few triangles) queried depth
+//! first, nearer child first, pruned by the squared distance to each node's box.
+//!
+//! Used for projection onto the input surface and for the Hausdorff measure. Floating point
+//! only: it measures distances, it decides nothing combinatorial.
+
+use crate::geom::vec3::{add, cross, dot, scale, sub};
+
+type P3 = [f64; 3];
+
+const LEAF: usize = 4;
+
+#[derive(Debug, Clone)]
+struct Node {
+    lo: P3,
+    hi: P3,
+    /// Leaf: `start..start + count` in `order`; inner: `start` is the right child (the left one
+    /// follows the node), `count == 0`.
+    start: u32,
+    count: u32,
+}
+
+/// The closest point of a triangle set to a query point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Closest {
+    /// Squared distance.
+    pub d2: f64,
+    /// The closest point.
+    pub point: P3,
+    /// Index of the triangle it lies on (in the order the triangles were given).
+    pub triangle: u32,
+}
+
+/// A bounding-volume hierarchy over triangles, for closest-point queries.
+#[derive(Debug, Clone)]
+pub struct Bvh {
+    tris: Vec<[P3; 3]>,
+    ids: Vec<u32>,
+    order: Vec<u32>,
+    nodes: Vec<Node>,
+}
+
+/// The closest point of triangle `t` to `p` (Voronoi regions of the corners, edges and face,
+/// tested in turn with barycentric dot products).
+pub fn closest_on_triangle(p: P3, t: &[P3; 3]) -> P3 {
+    let [a, b, c] = *t;
+    let ab = sub(b, a);
+    let ac = sub(c, a);
+    let ap = sub(p, a);
+    let d1 = dot(ab, ap);
+    let d2 = dot(ac, ap);
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return a;
+    }
+    let bp = sub(p, b);
+    let d3 = dot(ab, bp);
+    let d4 = dot(ac, bp);
+    if d3 >= 0.0 && d4 <= d3 {
+        return b;
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return add(a, scale(ab, v));
+    }
+    let cp = sub(p, c);
+    let d5 = dot(ab, cp);
+    let d6 = dot(ac, cp);
+    if d6 >= 0.0 && d5 <= d6 {
+        return c;
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return add(a, scale(ac, w));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return add(b, scale(sub(c, b), w));
+    }
+    let denom = va + vb + vc;
+    if denom == 0.0 || !denom.is_finite() {
+        // Degenerate triangle: the best of its three edges.
+        let mut best = a;
+        let mut bd = f64::INFINITY;
+        for (u, v) in [(a, b), (b, c), (c, a)] {
+            let q = closest_on_segment(p, u, v);
+            let d = dist2(p, q);
+            if d < bd {
+                bd = d;
+                best = q;
+            }
+        }
+        return best;
+    }
+    let v = vb / denom;
+    let w = vc / denom;
+    add(a, add(scale(ab, v), scale(ac, w)))
+}
+
+/// The closest point of segment `uv` to `p`.
+pub fn closest_on_segment(p: P3, u: P3, v: P3) -> P3 {
+    let d = sub(v, u);
+    let l = dot(d, d);
+    if l == 0.0 {
+        return u;
+    }
+    let s = (dot(sub(p, u), d) / l).clamp(0.0, 1.0);
+    add(u, scale(d, s))
+}
+
+/// Squared distance.
+#[inline]
+pub fn dist2(a: P3, b: P3) -> f64 {
+    let d = sub(a, b);
+    dot(d, d)
+}
+
+fn box_d2(p: P3, lo: P3, hi: P3) -> f64 {
+    let mut s = 0.0;
+    for k in 0..3 {
+        let e = if p[k] < lo[k] {
+            lo[k] - p[k]
+        } else if p[k] > hi[k] {
+            p[k] - hi[k]
+        } else {
+            0.0
+        };
+        s += e * e;
+    }
+    s
+}
+
+/// The unit normal of a triangle (zero if degenerate).
+pub fn unit_normal(t: &[P3; 3]) -> P3 {
+    let n = cross(sub(t[1], t[0]), sub(t[2], t[0]));
+    let l = dot(n, n).sqrt();
+    if l > 0.0 { scale(n, 1.0 / l) } else { [0.0; 3] }
+}
+
+impl Bvh {
+    /// Index the given triangles; `ids[i]` is what a query returns for `tris[i]`.
+    pub fn new(tris: Vec<[P3; 3]>, ids: Vec<u32>) -> Bvh {
+        assert_eq!(tris.len(), ids.len());
+        let n = tris.len();
+        let cent: Vec<P3> = tris
+            .iter()
+            .map(|t| [0, 1, 2].map(|k| (t[0][k] + t[1][k] + t[2][k]) / 3.0))
+            .collect();
+        let mut order: Vec<u32> = (0..n as u32).collect();
+        let mut nodes = Vec::with_capacity(2 * n / LEAF + 1);
+        if n > 0 {
+            build(&tris, &cent, &mut order, 0, n, &mut nodes);
+        }
+        Bvh {
+            tris,
+            ids,
+            order,
+            nodes,
+        }
+    }
+
+    /// Number of triangles.
+    pub fn len(&self) -> usize {
+        self.tris.len()
+    }
+
+    /// Whether there are no triangles.
+    pub fn is_empty(&self) -> bool {
+        self.tris.is_empty()
+    }
+
+    /// The closest point to `p` no farther than `sqrt(max_d2)` (`None` if none is).
+    pub fn closest_within(&self, p: P3, max_d2: f64) -> Option<Closest> {
+        if self.nodes.is_empty() {
+            return None;
+        }
+        let mut best = Closest {
+            d2: max_d2,
+            point: p,
+            triangle: u32::MAX,
+        };
+        let mut stack: Vec<u32> = Vec::with_capacity(64);
+        stack.push(0);
+        while let Some(i) = stack.pop() {
+            let node = &self.nodes[i as usize];
+            if box_d2(p, node.lo, node.hi) >= best.d2 {
+                continue;
+            }
+            if node.count > 0 {
+                for &k in &self.order[node.start as usize..(node.start + node.count) as usize] {
+                    let q = closest_on_triangle(p, &self.tris[k as usize]);
+                    let d = dist2(p, q);
+                    if d < best.d2 || (d == best.d2 && best.triangle == u32::MAX) {
+                        best = Closest {
+                            d2: d,
+                            point: q,
+                            triangle: self.ids[k as usize],
+                        };
+                    }
+                }
+            } else {
+                let l = i + 1;
+                let r = node.start;
+                let dl = box_d2(p, self.nodes[l as usize].lo, self.nodes[l as usize].hi);
+                let dr = box_d2(p, self.nodes[r as usize].lo, self.nodes[r as usize].hi);
+                // Nearer child popped first.
+                if dl <= dr {
+                    stack.push(r);
+                    stack.push(l);
+                } else {
+                    stack.push(l);
+                    stack.push(r);
+                }
+            }
+        }
+        (best.triangle != u32::MAX).then_some(best)
+    }
+
+    /// Whether some triangle is within `sqrt(r2)` of `p` (stops at the first one found).
+    pub fn any_within(&self, p: P3, r2: f64) -> bool {
+        if self.nodes.is_empty() {
+            return false;
+        }
+        let mut stack: Vec<u32> = Vec::with_capacity(64);
+        stack.push(0);
+        while let Some(i) = stack.pop() {
+            let node = &self.nodes[i as usize];
+            if box_d2(p, node.lo, node.hi) > r2 {
+                continue;
+            }
+            if node.count > 0 {
+                for &k in &self.order[node.start as usize..(node.start + node.count) as usize] {
+                    if dist2(p, closest_on_triangle(p, &self.tris[k as usize])) <= r2 {
+                        return true;
+                    }
+                }
+            } else {
+                let l = i + 1;
+                let r = node.start;
+                let dl = box_d2(p, self.nodes[l as usize].lo, self.nodes[l as usize].hi);
+                let dr = box_d2(p, self.nodes[r as usize].lo, self.nodes[r as usize].hi);
+                if dl <= dr {
+                    stack.push(r);
+                    stack.push(l);
+                } else {
+                    stack.push(l);
+                    stack.push(r);
+                }
+            }
+        }
+        false
+    }
+
+    /// The closest point to `p` (`None` only for an empty index).
+    pub fn closest(&self, p: P3) -> Option<Closest> {
+        self.closest_within(p, f64::INFINITY)
+    }
+}
+
+/// One [`Bvh`] per side-label pair: projection and distances stay on the sheet a triangle
+/// belongs to (an interface is never measured against another interface or shell).
+#[derive(Debug, Clone, Default)]
+pub struct PatchIndex {
+    keys: Vec<[u32; 2]>,
+    bvhs: Vec<Bvh>,
+}
+
+impl PatchIndex {
+    /// Index the triangles of `tris` (over `points`) by their `sides`, skipping those with
+    /// `alive[t] == false` when `alive` is given. Returned triangle ids are indices into `tris`.
+    pub fn new(
+        points: &[P3],
+        tris: &[[u32; 3]],
+        sides: &[[u32; 2]],
+        alive: Option<&[bool]>,
+    ) -> PatchIndex {
+        let mut keys: Vec<[u32; 2]> = sides.to_vec();
+        keys.sort_unstable();
+        keys.dedup();
+        let mut parts: Vec<(Vec<[P3; 3]>, Vec<u32>)> = vec![Default::default(); keys.len()];
+        for (t, tri) in tris.iter().enumerate() {
+            if alive.is_some_and(|a| !a[t]) {
+                continue;
+            }
+            let k = keys.binary_search(&sides[t]).unwrap_or(0);
+            parts[k].0.push(tri.map(|v| points[v as usize]));
+            parts[k].1.push(t as u32);
+        }
+        let bvhs = parts.into_iter().map(|(t, i)| Bvh::new(t, i)).collect();
+        PatchIndex { keys, bvhs }
+    }
+
+    /// The index of the triangles with side labels `sides`.
+    pub fn get(&self, sides: [u32; 2]) -> Option<&Bvh> {
+        self.keys.binary_search(&sides).ok().map(|k| &self.bvhs[k])
+    }
+
+    /// The side-label pairs indexed.
+    pub fn keys(&self) -> &[[u32; 2]] {
+        &self.keys
+    }
+}
+
+fn build(
+    tris: &[[P3; 3]],
+    cent: &[P3],
+    order: &mut [u32],
+    start: usize,
+    end: usize,
+    nodes: &mut Vec<Node>,
+) -> usize {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    let mut clo = [f64::INFINITY; 3];
+    let mut chi = [f64::NEG_INFINITY; 3];
+    for &k in &order[start..end] {
+        for p in &tris[k as usize] {
+            for a in 0..3 {
+                lo[a] = lo[a].min(p[a]);
+                hi[a] = hi[a].max(p[a]);
+            }
+        }
+        let c = cent[k as usize];
+        for a in 0..3 {
+            clo[a] = clo[a].min(c[a]);
+            chi[a] = chi[a].max(c[a]);
+        }
+    }
+    let me = nodes.len();
+    nodes.push(Node {
+        lo,
+        hi,
+        start: start as u32,
+        count: (end - start) as u32,
+    });
+    if end - start <= LEAF {
+        return me;
+    }
+    let axis = (0..3)
+        .max_by(|&a, &b| (chi[a] - clo[a]).total_cmp(&(chi[b] - clo[b])))
+        .unwrap_or(0);
+    let mid = (start + end) / 2;
+    order[start..end].select_nth_unstable_by(mid - start, |&x, &y| {
+        cent[x as usize][axis]
+            .total_cmp(&cent[y as usize][axis])
+            .then(x.cmp(&y))
+    });
+    build(tris, cent, order, start, mid, nodes);
+    let r = build(tris, cent, order, mid, end, nodes);
+    nodes[me].start = r as u32;
+    nodes[me].count = 0;
+    me
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn closest_point_matches_brute_force() {
+        let s = crate::SurfaceMesh::icosphere(2.0, 2);
+        let tris: Vec<[P3; 3]> = (0..s.n_triangles()).map(|t| s.corners(t)).collect();
+        let bvh = Bvh::new(tris.clone(), (0..tris.len() as u32).collect());
+        let mut x = 0.1234f64;
+        for _ in 0..200 {
+            let mut p = [0.0; 3];
+            for c in &mut p {
+                x = (x * 9301.0 + 49297.0) % 233280.0;
+                *c = x / 233280.0 * 6.0 - 3.0;
+            }
+            let got = bvh.closest(p).unwrap();
+            let want = tris
+                .iter()
+                .map(|t| dist2(p, closest_on_triangle(p, t)))
+                .fold(f64::INFINITY, f64::min);
+            assert!((got.d2 - want).abs() <= 1e-12 * (1.0 + want));
+        }
+    }
+
+    #[test]
+    fn closest_on_triangle_regions() {
+        let t = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        assert!(dist2(closest_on_triangle([0.2, 0.2, 1.0], &t), [0.2, 0.2, 0.0]) < 1e-30);
+        assert_eq!(closest_on_triangle([-1.0, -1.0, 0.0], &t), [0.0, 0.0, 0.0]);
+        assert_eq!(closest_on_triangle([2.0, -1.0, 0.0], &t), [1.0, 0.0, 0.0]);
+        assert_eq!(closest_on_triangle([0.5, -1.0, 0.0], &t), [0.5, 0.0, 0.0]);
+        let q = closest_on_triangle([1.0, 1.0, 0.0], &t);
+        assert!((q[0] - 0.5).abs() < 1e-15 && (q[1] - 0.5).abs() < 1e-15);
+    }
+}

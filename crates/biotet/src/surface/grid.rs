@@ -1,0 +1,100 @@
+//! A hashed uniform grid of the triangles being remeshed, updated as they change: the
+//! candidates for the exact intersection test of every new triangle. Each triangle is listed in
+//! every cell its bounding box overlaps; the box cells are remembered so removal does not need
+//! the (possibly moved) coordinates.
+
+use rustc_hash::FxHashMap;
+
+type P3 = [f64; 3];
+type Cells = ([i32; 3], [i32; 3]);
+
+/// The grid.
+#[derive(Debug, Clone, Default)]
+pub struct Grid {
+    h: f64,
+    cells: FxHashMap<[i32; 3], Vec<u32>>,
+    of: Vec<Option<Cells>>,
+}
+
+/// The bounding box of a triangle.
+pub fn tri_box(t: &[P3; 3]) -> (P3, P3) {
+    let mut lo = t[0];
+    let mut hi = t[0];
+    for p in &t[1..] {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    (lo, hi)
+}
+
+impl Grid {
+    /// An empty grid of cell size `h`.
+    pub fn new(h: f64) -> Grid {
+        Grid {
+            h,
+            ..Default::default()
+        }
+    }
+
+    fn range(&self, lo: P3, hi: P3) -> Cells {
+        (
+            lo.map(|c| (c / self.h).floor() as i32),
+            hi.map(|c| (c / self.h).floor() as i32),
+        )
+    }
+
+    /// List triangle `t` with corners `c`.
+    pub fn insert(&mut self, t: u32, c: &[P3; 3]) {
+        let (lo, hi) = tri_box(c);
+        let r = self.range(lo, hi);
+        if self.of.len() <= t as usize {
+            self.of.resize(t as usize + 1, None);
+        }
+        debug_assert!(self.of[t as usize].is_none());
+        self.of[t as usize] = Some(r);
+        for i in r.0[0]..=r.1[0] {
+            for j in r.0[1]..=r.1[1] {
+                for k in r.0[2]..=r.1[2] {
+                    self.cells.entry([i, j, k]).or_default().push(t);
+                }
+            }
+        }
+    }
+
+    /// Unlist triangle `t`.
+    pub fn remove(&mut self, t: u32) {
+        let Some(r) = self.of.get_mut(t as usize).and_then(|x| x.take()) else {
+            return;
+        };
+        for i in r.0[0]..=r.1[0] {
+            for j in r.0[1]..=r.1[1] {
+                for k in r.0[2]..=r.1[2] {
+                    if let Some(v) = self.cells.get_mut(&[i, j, k])
+                        && let Some(p) = v.iter().position(|&x| x == t)
+                    {
+                        v.swap_remove(p);
+                    }
+                }
+            }
+        }
+    }
+
+    /// The triangles whose boxes' cells overlap the box `lo..hi`, sorted, without repeats.
+    pub fn query(&self, lo: P3, hi: P3, out: &mut Vec<u32>) {
+        out.clear();
+        let r = self.range(lo, hi);
+        for i in r.0[0]..=r.1[0] {
+            for j in r.0[1]..=r.1[1] {
+                for k in r.0[2]..=r.1[2] {
+                    if let Some(v) = self.cells.get(&[i, j, k]) {
+                        out.extend_from_slice(v);
+                    }
+                }
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+    }
+}
