@@ -68,6 +68,7 @@ struct MeshOptions {
     max_voxels: usize,
     steiner: bool,
     stages: [bool; 4],
+    surface_tolerance: Option<f64>,
 }
 
 /// Validate a labelled surface as `biotet mesh` does: shells assembled and labelled innermost
@@ -116,6 +117,21 @@ fn mesh_with(
 ) -> Result<(TetMesh, serde_json::Value), Failure> {
     let name = surface.name().to_string();
     let (surface, shells) = prepare(surface)?;
+    // The opt-in surface stage (as `biotet mesh --surface-tolerance D`).
+    let (surface, surface_report) = match o.surface_tolerance {
+        None => (surface, None),
+        Some(d) => {
+            progress("improving the surface");
+            let so = biotet::surface::SurfaceOptions {
+                tolerance: d,
+                edge_length: o.size,
+                ..Default::default()
+            };
+            let (s, r) = biotet::surface::improve(&surface, &so)
+                .map_err(|e| Failure::new(Kind::Meshing, format!("{name}: surface stage: {e}")))?;
+            (s, Some(r))
+        }
+    };
     let spec = match o.size {
         Some(h) => SizeSpec::Uniform(h),
         None => SizeSpec::FromSurface { grading: o.grading },
@@ -176,7 +192,7 @@ fn mesh_with(
             triangles,
         });
     }
-    let report = json!({
+    let mut report = json!({
         "input": name,
         "n_surface_triangles": surface.triangles.len(),
         "shells": shells,
@@ -186,6 +202,9 @@ fn mesh_with(
         "forcing": forcing,
         "mesh_bytes": mesh.bytes(),
     });
+    if let Some(r) = surface_report {
+        report["surface"] = serde_json::to_value(r).unwrap_or_default();
+    }
     Ok((mesh, report))
 }
 
@@ -202,6 +221,7 @@ fn mesh_options(
     max_voxels: usize,
     steiner: bool,
     stages: [bool; 4],
+    surface_tolerance: Option<f64>,
 ) -> PyResult<MeshOptions> {
     let box_zones = match zone {
         "euclidean" => false,
@@ -223,13 +243,15 @@ fn mesh_options(
         max_voxels,
         steiner,
         stages,
+        surface_tolerance,
     })
 }
 
 /// Mesh the volume inside a closed surface given as arrays (see `biotet.mesh`).
 #[pyfunction]
 #[pyo3(signature = (points, triangles, shell_labels, side_labels, name, size, grading, min_size,
-    max_size, region_sizes, resolution, zone, max_voxels, steiner, stages, threads, progress))]
+    max_size, region_sizes, resolution, zone, max_voxels, steiner, stages, surface_tolerance,
+    threads, progress))]
 #[allow(clippy::too_many_arguments)]
 fn mesh_arrays<'py>(
     py: Python<'py>,
@@ -248,6 +270,7 @@ fn mesh_arrays<'py>(
     max_voxels: usize,
     steiner: bool,
     stages: [bool; 4],
+    surface_tolerance: Option<f64>,
     threads: Option<usize>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<MeshOut<'py>> {
@@ -262,6 +285,7 @@ fn mesh_arrays<'py>(
         max_voxels,
         steiner,
         stages,
+        surface_tolerance,
     )?;
     let surface = surface_from(
         &points,
@@ -279,7 +303,7 @@ fn mesh_arrays<'py>(
 /// Mesh the volume inside the closed surfaces in files (see `biotet.mesh_file`).
 #[pyfunction]
 #[pyo3(signature = (paths, labels, size, grading, min_size, max_size, region_sizes, resolution,
-    zone, max_voxels, steiner, stages, threads, progress))]
+    zone, max_voxels, steiner, stages, surface_tolerance, threads, progress))]
 #[allow(clippy::too_many_arguments)]
 fn mesh_files<'py>(
     py: Python<'py>,
@@ -295,6 +319,7 @@ fn mesh_files<'py>(
     max_voxels: usize,
     steiner: bool,
     stages: [bool; 4],
+    surface_tolerance: Option<f64>,
     threads: Option<usize>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<MeshOut<'py>> {
@@ -309,6 +334,7 @@ fn mesh_files<'py>(
         max_voxels,
         steiner,
         stages,
+        surface_tolerance,
     )?;
     let (mesh, report) = guarded(py, threads, move || {
         let surface = read_surfaces(&paths, labels)?;

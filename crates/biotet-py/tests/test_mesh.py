@@ -135,3 +135,11 @@ def test_read_write_roundtrip(tmp_path, brain_mesh):
         np.testing.assert_array_equal(back.points, brain_mesh.points)
     s = biotet.read(SHAPES / "tm_box.off")
     assert isinstance(s, biotet.Surface) and s.triangles.shape == (12, 3)
+
+
+def test_surface_tolerance_moves_the_surface_within_the_bound(brain):
+    m = biotet.mesh(brain.points, brain.triangles, surface_tolerance=0.5)
+    s = m.report["surface"]
+    assert s["hausdorff_in_to_out"] <= 0.5 and s["hausdorff_out_to_in"] <= 0.5
+    assert m.report["quality"]["n_dihedral_lt_10"] < 100
+    assert biotet.check(m)["valid"]

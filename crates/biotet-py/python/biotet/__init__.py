@@ -228,6 +228,7 @@ def _mesh_options(
     max_voxels: int,
     steiner: bool,
     stages: tuple[bool, bool, bool, bool],
+    surface_tolerance: float | None,
     threads: int | None,
     progress: Callable[[str], Any] | None,
 ) -> dict:
@@ -242,6 +243,7 @@ def _mesh_options(
         max_voxels=max_voxels,
         steiner=steiner,
         stages=stages,
+        surface_tolerance=surface_tolerance,
         threads=threads,
         progress=_progress(progress),
     )
@@ -266,6 +268,7 @@ def mesh(
     improve: bool = True,
     smooth: bool = True,
     polish: bool = True,
+    surface_tolerance: float | None = None,
     threads: int | None = None,
     progress: Callable[[str], Any] | None = None,
     name: str = "arrays",
@@ -279,7 +282,9 @@ def mesh(
     surface's own edges growing by ``grading`` per unit distance, clamped to
     ``min_size``/``max_size``; ``region_sizes`` maps a region label to its size. ``steiner=False``
     forbids interior points added by recovery; ``recover``/``improve``/``smooth``/``polish``
-    switch stages off. ``threads``: worker threads (default one per core; the result does not
+    switch stages off. ``surface_tolerance=D`` first remeshes the surface within a two-sided
+    Hausdorff distance D (``biotet mesh --surface-tolerance D``; reported in
+    ``report["surface"]``): fewer slivers, the surface no longer kept exactly. ``threads``: worker threads (default one per core; the result does not
     depend on it). Raises :class:`InvalidSurfaceError` for an invalid surface and
     :class:`MeshingError` if meshing cannot finish.
     """
@@ -289,7 +294,7 @@ def mesh(
     shell = None if labels is None else [int(x) for x in labels]
     o = _mesh_options(
         size, grading, min_size, max_size, region_sizes, resolution, zone, max_voxels,
-        steiner, (recover, improve, smooth, polish), threads, progress,
+        steiner, (recover, improve, smooth, polish), surface_tolerance, threads, progress,
     )
     return _tet(_call(_core.mesh_arrays, v, f, shell, s, name, **o))
 
@@ -311,6 +316,7 @@ def mesh_file(
     improve: bool = True,
     smooth: bool = True,
     polish: bool = True,
+    surface_tolerance: float | None = None,
     threads: int | None = None,
     progress: Callable[[str], Any] | None = None,
 ) -> TetMesh:
@@ -329,7 +335,7 @@ def mesh_file(
         per_file[hits[0]] = [int(x) for x in ls]
     o = _mesh_options(
         size, grading, min_size, max_size, region_sizes, resolution, zone, max_voxels,
-        steiner, (recover, improve, smooth, polish), threads, progress,
+        steiner, (recover, improve, smooth, polish), surface_tolerance, threads, progress,
     )
     return _tet(_call(_core.mesh_files, ps, per_file, **o))
 

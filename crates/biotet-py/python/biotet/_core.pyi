@@ -28,6 +28,7 @@ def mesh_arrays(
     max_voxels: int,
     steiner: bool,
     stages: tuple[bool, bool, bool, bool],
+    surface_tolerance: float | None,
     threads: int | None,
     progress: Callable[[str], Any] | None,
 ) -> _MeshOut: ...
@@ -44,6 +45,7 @@ def mesh_files(
     max_voxels: int,
     steiner: bool,
     stages: tuple[bool, bool, bool, bool],
+    surface_tolerance: float | None,
     threads: int | None,
     progress: Callable[[str], Any] | None,
 ) -> _MeshOut: ...
