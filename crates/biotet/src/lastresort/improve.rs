@@ -825,6 +825,24 @@ fn step(w: &mut Work, tet: u32, scratch: &mut Vec<u32>) -> Step {
         .copied()
         .filter(|&t| w.tets[t as usize].iter().filter(|v| tv.contains(v)).count() >= 2)
         .collect();
+    // A star too large to be searched (a corner of a large input face over fine nodes holds
+    // thousands of tets): only the edge cavity is tried, and only it is claimed, else every bad
+    // tet around that corner conflicts with the others and the queue turns over one at a time
+    // (a unit cube at --size 0.05 spent 25 s so).
+    if tets.len() > opts.max_cavity_tets {
+        if edges.len() > opts.max_cavity_tets {
+            return Step::Done;
+        }
+        if w.claimed(&edges) {
+            return Step::Conflict;
+        }
+        w.claim(&edges);
+        return Step::Task(Box::new(Task {
+            tet,
+            local: false,
+            tries: vec![(Kind::Edges, edges)],
+        }));
+    }
     // Grown by the next ring, tried when the search fails past its root: a cavity pruned at once
     // (a shell face without any candidate) almost never has a better grown fill (brain_20k: 11
     // of 620 such grown cavities succeeded, for a third of the sliver removal's time).
