@@ -63,11 +63,13 @@ enum Command {
     /// Remesh part of a tet mesh in place: one region, or the tets meeting a box or a sphere,
     /// at a new size; every other tet kept exactly.
     Remesh(cmd::remesh::Args),
-    /// Surface operations: `surface improve` remeshes a surface within a distance bound.
+    /// Surfaces: `surface IMAGE -o OUT` extracts the labelled surface of a label image;
+    /// `surface improve` remeshes a surface within a distance bound.
     Surface(cmd::surface::Args),
     /// Validate closed surfaces: closed, manifold, consistently oriented, no self-intersection.
     Validate(cmd::validate::Args),
-    /// Extract the labelled surface of a label image (NIfTI, MGH, NRRD, MetaImage, VTI).
+    /// The former name of `surface IMAGE` (kept for scripts).
+    #[command(hide = true)]
     SurfaceExtract(cmd::extract::Args),
 }
 

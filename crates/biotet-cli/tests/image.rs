@@ -1,4 +1,4 @@
-//! Label images in: `biotet surface-extract` and `biotet mesh IMAGE`, on the small fixtures of
+//! Label images in: `biotet surface IMAGE` and `biotet mesh IMAGE`, on the small fixtures of
 //! biotet-io (the same 5×4×3 volume in every format, rotated, anisotropic).
 
 mod support;
@@ -13,7 +13,7 @@ fn surface_extract_writes_a_labelled_surface_that_validates() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("s.vtu");
     let r = biotet(&[
-        "surface-extract",
+        "surface",
         s(&fixture("label_lps_gzip.nrrd")),
         "-o",
         s(&out),
@@ -93,15 +93,10 @@ fn mesh_an_image_with_label_options() {
 
 #[test]
 fn bad_image_options_are_clear_errors() {
-    let r = biotet(&["surface-extract", s(&fixture("label_fractional.nii"))]);
+    let r = biotet(&["surface", s(&fixture("label_fractional.nii"))]);
     assert!(!r.status.success());
     assert!(stderr(&r).contains("whole numbers"), "{}", stderr(&r));
-    let r = biotet(&[
-        "surface-extract",
-        s(&fixture("label_uint8.mgz")),
-        "--merge",
-        "2=x",
-    ]);
+    let r = biotet(&["surface", s(&fixture("label_uint8.mgz")), "--merge", "2=x"]);
     assert!(!r.status.success());
     assert!(stderr(&r).contains("--merge"), "{}", stderr(&r));
 }

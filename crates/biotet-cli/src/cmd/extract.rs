@@ -309,15 +309,15 @@ pub fn region_text(rows: &[serde_json::Value]) -> String {
 pub struct Args {
     /// Label image: .nii, .nii.gz, .mgh, .mgz, .nrrd, .nhdr, .mha, .mhd, .vti (world
     /// coordinates RAS+, see README).
-    image: PathBuf,
+    pub(crate) image: PathBuf,
     /// Output labelled surface (.vtu, .ply or .mesh keep the labels on both sides of each
     /// triangle).
     #[arg(short, long, value_name = "OUT")]
-    output: Option<PathBuf>,
+    pub(crate) output: Option<PathBuf>,
     #[command(flatten)]
-    image_args: ImageArgs,
+    pub(crate) image_args: ImageArgs,
     #[command(flatten)]
-    common: Common,
+    pub(crate) common: Common,
 }
 
 /// Run `biotet surface-extract`.

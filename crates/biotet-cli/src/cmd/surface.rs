@@ -20,9 +20,22 @@ Examples:
 
 /// Arguments of `biotet surface`.
 #[derive(clap::Args)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
 pub struct Args {
     #[command(subcommand)]
-    command: Sub,
+    command: Option<Sub>,
+    /// Label image: .nii, .nii.gz, .mgh, .mgz, .nrrd, .nhdr, .mha, .mhd, .vti (world
+    /// coordinates RAS+, see README); its labelled surface is written, as `surface extract`.
+    #[arg(required = true)]
+    image: Option<PathBuf>,
+    /// Output labelled surface (.vtu, .ply or .mesh keep the labels on both sides of each
+    /// triangle).
+    #[arg(short, long, value_name = "OUT")]
+    output: Option<PathBuf>,
+    #[command(flatten)]
+    image_args: super::extract::ImageArgs,
+    #[command(flatten)]
+    common: Common,
 }
 
 #[derive(clap::Subcommand)]
@@ -32,6 +45,9 @@ enum Sub {
     /// volume change reported.
     #[command(after_help = EXAMPLES)]
     Improve(ImproveArgs),
+    /// The labelled surface of a label image (NIfTI, MGH, NRRD, MetaImage, VTI): every interface
+    /// between two labels, shared by both (`biotet surface IMAGE -o OUT` is the same).
+    Extract(super::extract::Args),
 }
 
 /// Options of the stage, shared with `biotet mesh`.
@@ -78,8 +94,16 @@ pub struct ImproveArgs {
 
 /// Run `biotet surface`.
 pub fn run(a: Args) -> Result<ExitCode> {
-    match a.command {
-        Sub::Improve(a) => run_improve(a),
+    match (a.command, a.image) {
+        (Some(Sub::Improve(a)), _) => run_improve(a),
+        (Some(Sub::Extract(a)), _) => super::extract::run(a),
+        (None, Some(image)) => super::extract::run(super::extract::Args {
+            image,
+            output: a.output,
+            image_args: a.image_args,
+            common: a.common,
+        }),
+        (None, None) => anyhow::bail!("give a label image, or a subcommand (see --help)"),
     }
 }
 
