@@ -74,7 +74,7 @@ def child(case: str, surface: str) -> dict | None:
         print(f"  {case}: failed: {r.stderr.strip().splitlines()[-1] if r.stderr.strip() else r.returncode}",
               file=sys.stderr)
         return None
-    return json.loads(r.stdout)
+    return json.loads(r.stdout.strip().splitlines()[-1])
 
 
 def cli(biotet: str, surface: str) -> dict:
