@@ -11,11 +11,13 @@
 //! coordinates bit for bit and its label. The cost is that of meshing the cavity, plus one pass
 //! over the mesh to select, splice and rebuild adjacency.
 
+use crate::geom::vec3::{cross, dot, norm, sub};
 use crate::mesh::surface::SurfaceMesh;
 use crate::mesh::tet::{NO_NEIGHBOR, TET_FACES, TetMesh};
 use crate::mesh::validate::{SurfaceError, ValidateOptions, validate_surface};
 use crate::pipeline::{MeshReport, PipelineError, PipelineOptions, mesh_surface};
 use crate::sizing::{Sizing, SizingError};
+use crate::surface::bvh::closest_on_triangle;
 use rustc_hash::FxHashMap;
 use serde::Serialize;
 use std::time::Instant;
@@ -147,20 +149,6 @@ fn meets(zone: &Zone, label: u32, c: &[P3; 4]) -> bool {
     }
 }
 
-fn sub(a: P3, b: P3) -> P3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dot(a: P3, b: P3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: P3, b: P3) -> P3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
 /// Separating-axis test of a tet and an axis-aligned box (both closed).
 fn tet_meets_box(c: &[P3; 4], lo: P3, hi: P3) -> bool {
     let box_corners: Vec<P3> = (0..8)
@@ -215,55 +203,8 @@ fn tet_distance(c: &[P3; 4], p: P3) -> f64 {
     }
     TET_FACES
         .iter()
-        .map(|f| point_triangle_distance(p, [c[f[0]], c[f[1]], c[f[2]]]))
+        .map(|f| norm(sub(p, closest_on_triangle(p, &[c[f[0]], c[f[1]], c[f[2]]]))))
         .fold(f64::INFINITY, f64::min)
-}
-
-/// Distance from `p` to the closed triangle `t` (Ericson's region tests).
-fn point_triangle_distance(p: P3, t: [P3; 3]) -> f64 {
-    let [a, b, c] = t;
-    let (ab, ac, ap) = (sub(b, a), sub(c, a), sub(p, a));
-    let (d1, d2) = (dot(ab, ap), dot(ac, ap));
-    let at = |q: P3| dot(sub(p, q), sub(p, q)).sqrt();
-    let lerp = |x: P3, y: P3, s: f64| {
-        [
-            x[0] + s * (y[0] - x[0]),
-            x[1] + s * (y[1] - x[1]),
-            x[2] + s * (y[2] - x[2]),
-        ]
-    };
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return at(a);
-    }
-    let bp = sub(p, b);
-    let (d3, d4) = (dot(ab, bp), dot(ac, bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return at(b);
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return at(lerp(a, b, d1 / (d1 - d3)));
-    }
-    let cp = sub(p, c);
-    let (d5, d6) = (dot(ab, cp), dot(ac, cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return at(c);
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return at(lerp(a, c, d2 / (d2 - d6)));
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return at(lerp(b, c, (d4 - d3) / ((d4 - d3) + (d5 - d6))));
-    }
-    let denom = 1.0 / (va + vb + vc);
-    let (v, w) = (vb * denom, vc * denom);
-    at([
-        a[0] + ab[0] * v + ac[0] * w,
-        a[1] + ab[1] * v + ac[1] * w,
-        a[2] + ab[2] * v + ac[2] * w,
-    ])
 }
 
 /// The shell of the carved tets `tets` (all of region `label`): its faces towards tets not
