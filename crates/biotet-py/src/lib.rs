@@ -56,7 +56,10 @@ type SurfaceOut<'py> = (
 /// under it causes them (as `biotet mesh` does).
 const FORCED_DEG: f64 = 10.0;
 
-/// Sizing and stage switches of `mesh`, as the CLI's flags.
+/// Sizing and stage switches of `mesh`, as the CLI's flags: a dict from the Python layer
+/// (`biotet._mesh_options`), one key per field.
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
 struct MeshOptions {
     size: Option<f64>,
     grading: f64,
@@ -64,7 +67,7 @@ struct MeshOptions {
     max_size: Option<f64>,
     region_sizes: Vec<(u32, f64)>,
     resolution: f64,
-    box_zones: bool,
+    zone: String,
     max_voxels: usize,
     steiner: bool,
     stages: [bool; 4],
@@ -146,7 +149,7 @@ fn mesh_with(
     let seconds_sizing = clock.elapsed().as_secs_f64();
     let mut opts = PipelineOptions::default();
     opts.deploy.resolution = o.resolution;
-    opts.deploy.zone = if o.box_zones {
+    opts.deploy.zone = if o.zone == "box" {
         Zone::Box
     } else {
         Zone::Euclidean
@@ -208,50 +211,20 @@ fn mesh_with(
     Ok((mesh, report))
 }
 
-/// Read the options shared by `mesh_arrays` and `mesh_files`.
-#[allow(clippy::too_many_arguments)]
-fn mesh_options(
-    size: Option<f64>,
-    grading: f64,
-    min_size: Option<f64>,
-    max_size: Option<f64>,
-    region_sizes: Vec<(u32, f64)>,
-    resolution: f64,
-    zone: &str,
-    max_voxels: usize,
-    steiner: bool,
-    stages: [bool; 4],
-    surface_tolerance: Option<f64>,
-) -> PyResult<MeshOptions> {
-    let box_zones = match zone {
-        "euclidean" => false,
-        "box" => true,
-        z => {
-            return Err(pyo3::exceptions::PyValueError::new_err(format!(
-                "zone must be 'euclidean' or 'box', not {z:?}"
-            )));
-        }
-    };
-    Ok(MeshOptions {
-        size,
-        grading,
-        min_size,
-        max_size,
-        region_sizes,
-        resolution,
-        box_zones,
-        max_voxels,
-        steiner,
-        stages,
-        surface_tolerance,
-    })
+/// Refuse a zone other than the two the template knows.
+fn check_zone(o: &MeshOptions) -> PyResult<()> {
+    match o.zone.as_str() {
+        "euclidean" | "box" => Ok(()),
+        z => Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "zone must be 'euclidean' or 'box', not {z:?}"
+        ))),
+    }
 }
 
 /// Mesh the volume inside a closed surface given as arrays (see `biotet.mesh`).
 #[pyfunction]
-#[pyo3(signature = (points, triangles, shell_labels, side_labels, name, size, grading, min_size,
-    max_size, region_sizes, resolution, zone, max_voxels, steiner, stages, surface_tolerance,
-    threads, progress))]
+#[pyo3(signature = (points, triangles, shell_labels, side_labels, name, options, threads,
+    progress))]
 #[allow(clippy::too_many_arguments)]
 fn mesh_arrays<'py>(
     py: Python<'py>,
@@ -260,33 +233,11 @@ fn mesh_arrays<'py>(
     shell_labels: Option<Vec<u32>>,
     side_labels: Option<PyReadonlyArray2<'py, i64>>,
     name: String,
-    size: Option<f64>,
-    grading: f64,
-    min_size: Option<f64>,
-    max_size: Option<f64>,
-    region_sizes: Vec<(u32, f64)>,
-    resolution: f64,
-    zone: &str,
-    max_voxels: usize,
-    steiner: bool,
-    stages: [bool; 4],
-    surface_tolerance: Option<f64>,
+    options: MeshOptions,
     threads: Option<usize>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<MeshOut<'py>> {
-    let o = mesh_options(
-        size,
-        grading,
-        min_size,
-        max_size,
-        region_sizes,
-        resolution,
-        zone,
-        max_voxels,
-        steiner,
-        stages,
-        surface_tolerance,
-    )?;
+    check_zone(&options)?;
     let surface = surface_from(
         &points,
         &triangles,
@@ -295,50 +246,30 @@ fn mesh_arrays<'py>(
         name,
     )?;
     let (mesh, report) = guarded(py, threads, move || {
-        mesh_with(surface, &o, &|s| run::report_progress(progress.as_ref(), s))
+        mesh_with(surface, &options, &|s| {
+            run::report_progress(progress.as_ref(), s)
+        })
     })?;
     Ok(mesh_out(py, mesh, report.to_string()))
 }
 
 /// Mesh the volume inside the closed surfaces in files (see `biotet.mesh_file`).
 #[pyfunction]
-#[pyo3(signature = (paths, labels, size, grading, min_size, max_size, region_sizes, resolution,
-    zone, max_voxels, steiner, stages, surface_tolerance, threads, progress))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (paths, labels, options, threads, progress))]
 fn mesh_files<'py>(
     py: Python<'py>,
     paths: Vec<PathBuf>,
     labels: Vec<Option<Vec<u32>>>,
-    size: Option<f64>,
-    grading: f64,
-    min_size: Option<f64>,
-    max_size: Option<f64>,
-    region_sizes: Vec<(u32, f64)>,
-    resolution: f64,
-    zone: &str,
-    max_voxels: usize,
-    steiner: bool,
-    stages: [bool; 4],
-    surface_tolerance: Option<f64>,
+    options: MeshOptions,
     threads: Option<usize>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<MeshOut<'py>> {
-    let o = mesh_options(
-        size,
-        grading,
-        min_size,
-        max_size,
-        region_sizes,
-        resolution,
-        zone,
-        max_voxels,
-        steiner,
-        stages,
-        surface_tolerance,
-    )?;
+    check_zone(&options)?;
     let (mesh, report) = guarded(py, threads, move || {
         let surface = read_surfaces(&paths, labels)?;
-        mesh_with(surface, &o, &|s| run::report_progress(progress.as_ref(), s))
+        mesh_with(surface, &options, &|s| {
+            run::report_progress(progress.as_ref(), s)
+        })
     })?;
     Ok(mesh_out(py, mesh, report.to_string()))
 }

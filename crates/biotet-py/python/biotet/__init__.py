@@ -229,9 +229,8 @@ def _mesh_options(
     steiner: bool,
     stages: tuple[bool, bool, bool, bool],
     surface_tolerance: float | None,
-    threads: int | None,
-    progress: Callable[[str], Any] | None,
 ) -> dict:
+    """The options of ``mesh`` and ``mesh_file`` as the native module reads them."""
     return dict(
         size=size,
         grading=grading,
@@ -244,8 +243,6 @@ def _mesh_options(
         steiner=steiner,
         stages=stages,
         surface_tolerance=surface_tolerance,
-        threads=threads,
-        progress=_progress(progress),
     )
 
 
@@ -294,9 +291,9 @@ def mesh(
     shell = None if labels is None else [int(x) for x in labels]
     o = _mesh_options(
         size, grading, min_size, max_size, region_sizes, resolution, zone, max_voxels,
-        steiner, (recover, improve, smooth, polish), surface_tolerance, threads, progress,
+        steiner, (recover, improve, smooth, polish), surface_tolerance,
     )
-    return _tet(_call(_core.mesh_arrays, v, f, shell, s, name, **o))
+    return _tet(_call(_core.mesh_arrays, v, f, shell, s, name, o, threads, _progress(progress)))
 
 
 def mesh_file(
@@ -335,9 +332,9 @@ def mesh_file(
         per_file[hits[0]] = [int(x) for x in ls]
     o = _mesh_options(
         size, grading, min_size, max_size, region_sizes, resolution, zone, max_voxels,
-        steiner, (recover, improve, smooth, polish), surface_tolerance, threads, progress,
+        steiner, (recover, improve, smooth, polish), surface_tolerance,
     )
-    return _tet(_call(_core.mesh_files, ps, per_file, **o))
+    return _tet(_call(_core.mesh_files, ps, per_file, o, threads, _progress(progress)))
 
 
 def _surface_arrays(surface: Surface | tuple[Any, Any] | None) -> tuple[Any, Any]:

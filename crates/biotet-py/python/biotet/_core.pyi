@@ -1,6 +1,6 @@
 """Type stubs of the native module (biotet._core); use the functions of ``biotet`` instead."""
 
-from typing import Any, Callable, Sequence
+from typing import Any, Callable, Sequence, TypedDict
 
 import numpy as np
 import numpy.typing as npt
@@ -12,40 +12,33 @@ class CoreError(Exception):
 
 _MeshOut = tuple[npt.NDArray[np.float64], npt.NDArray[np.int32], npt.NDArray[np.int32], str]
 
+class _MeshOptions(TypedDict):
+    size: float | None
+    grading: float
+    min_size: float | None
+    max_size: float | None
+    region_sizes: Sequence[tuple[int, float]]
+    resolution: float
+    zone: str
+    max_voxels: int
+    steiner: bool
+    stages: tuple[bool, bool, bool, bool]
+    surface_tolerance: float | None
+
 def mesh_arrays(
     points: npt.NDArray[np.float64],
     triangles: npt.NDArray[np.int64],
     shell_labels: Sequence[int] | None,
     side_labels: npt.NDArray[np.int64] | None,
     name: str,
-    size: float | None,
-    grading: float,
-    min_size: float | None,
-    max_size: float | None,
-    region_sizes: Sequence[tuple[int, float]],
-    resolution: float,
-    zone: str,
-    max_voxels: int,
-    steiner: bool,
-    stages: tuple[bool, bool, bool, bool],
-    surface_tolerance: float | None,
+    options: _MeshOptions,
     threads: int | None,
     progress: Callable[[str], Any] | None,
 ) -> _MeshOut: ...
 def mesh_files(
     paths: Sequence[str],
     labels: Sequence[Sequence[int] | None],
-    size: float | None,
-    grading: float,
-    min_size: float | None,
-    max_size: float | None,
-    region_sizes: Sequence[tuple[int, float]],
-    resolution: float,
-    zone: str,
-    max_voxels: int,
-    steiner: bool,
-    stages: tuple[bool, bool, bool, bool],
-    surface_tolerance: float | None,
+    options: _MeshOptions,
     threads: int | None,
     progress: Callable[[str], Any] | None,
 ) -> _MeshOut: ...
