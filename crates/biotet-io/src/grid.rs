@@ -892,9 +892,13 @@ pub(crate) fn nifti_values(h: &NiftiHeader, l: &NiftiLayout, bytes: &[u8]) -> Ve
     }
 }
 
-/// Parse a NIfTI-1 or NIfTI-2 single file (`.nii`) held in memory, gzip-compressed or not
-/// (detected by the gzip magic bytes).
-pub fn parse_nifti(data: &[u8], file: &str) -> Result<ScalarGrid> {
+/// A NIfTI-1 or NIfTI-2 single file (`.nii`) held in memory, gzip-compressed or not (detected
+/// by the gzip magic bytes): its header, layout and voxel values (scaled), the voxel data
+/// checked to be all there. Shared by the size-field and label-image readers.
+pub(crate) fn nifti_voxels(
+    data: &[u8],
+    file: &str,
+) -> Result<(NiftiHeader, NiftiLayout, Vec<f64>)> {
     let gz;
     let data: &[u8] = if data.starts_with(&[0x1f, 0x8b]) {
         gz = gunzip_nifti(data, file)?;
@@ -919,6 +923,13 @@ pub fn parse_nifti(data: &[u8], file: &str) -> Result<ScalarGrid> {
         ));
     }
     let values = nifti_values(&h, &l, &data[l.offset..end]);
+    Ok((h, l, values))
+}
+
+/// Parse a NIfTI-1 or NIfTI-2 single file (`.nii`) held in memory, gzip-compressed or not
+/// (detected by the gzip magic bytes).
+pub fn parse_nifti(data: &[u8], file: &str) -> Result<ScalarGrid> {
+    let (h, l, values) = nifti_voxels(data, file)?;
     let a = nifti_affine(&h, file)?;
     let mut spacing = [0.0; 3];
     let mut direction = [[0.0; 3]; 3];
