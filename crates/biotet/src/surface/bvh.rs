@@ -202,21 +202,25 @@ impl Bvh {
                     }
                 }
             } else {
-                let l = i + 1;
-                let r = node.start;
-                let dl = box_d2(p, self.nodes[l as usize].lo, self.nodes[l as usize].hi);
-                let dr = box_d2(p, self.nodes[r as usize].lo, self.nodes[r as usize].hi);
-                // Nearer child popped first.
-                if dl <= dr {
-                    stack.push(r);
-                    stack.push(l);
-                } else {
-                    stack.push(l);
-                    stack.push(r);
-                }
+                self.push_children(p, i, node.start, &mut stack);
             }
         }
         (best.triangle != u32::MAX).then_some(best)
+    }
+
+    /// Push the children of inner node `i` (left `i + 1`, right `r`), the nearer to `p` last so
+    /// that it is popped first.
+    fn push_children(&self, p: P3, i: u32, r: u32, stack: &mut Vec<u32>) {
+        let l = i + 1;
+        let dl = box_d2(p, self.nodes[l as usize].lo, self.nodes[l as usize].hi);
+        let dr = box_d2(p, self.nodes[r as usize].lo, self.nodes[r as usize].hi);
+        if dl <= dr {
+            stack.push(r);
+            stack.push(l);
+        } else {
+            stack.push(l);
+            stack.push(r);
+        }
     }
 
     /// Whether some triangle is within `sqrt(r2)` of `p` (stops at the first one found).
@@ -238,17 +242,7 @@ impl Bvh {
                     }
                 }
             } else {
-                let l = i + 1;
-                let r = node.start;
-                let dl = box_d2(p, self.nodes[l as usize].lo, self.nodes[l as usize].hi);
-                let dr = box_d2(p, self.nodes[r as usize].lo, self.nodes[r as usize].hi);
-                if dl <= dr {
-                    stack.push(r);
-                    stack.push(l);
-                } else {
-                    stack.push(l);
-                    stack.push(r);
-                }
+                self.push_children(p, i, node.start, &mut stack);
             }
         }
         false
