@@ -101,6 +101,10 @@ fn main() -> ExitCode {
         default_hook(info);
     }));
     let cli = Cli::parse();
+    // The documentation test parses every command line of the docs without running it.
+    if std::env::var_os("BIOTET_PARSE_ONLY").is_some() {
+        return ExitCode::SUCCESS;
+    }
     if let Some(n) = cli.threads
         && let Err(e) = rayon::ThreadPoolBuilder::new()
             .num_threads(n)

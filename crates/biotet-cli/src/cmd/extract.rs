@@ -308,7 +308,7 @@ pub fn region_text(rows: &[serde_json::Value]) -> String {
 #[derive(clap::Args)]
 pub struct Args {
     /// Label image: .nii, .nii.gz, .mgh, .mgz, .nrrd, .nhdr, .mha, .mhd, .vti (world
-    /// coordinates RAS+, see README).
+    /// coordinates RAS+, see docs/formats.md).
     pub(crate) image: PathBuf,
     /// Output labelled surface (.vtu, .ply or .mesh keep the labels on both sides of each
     /// triangle).

@@ -47,7 +47,7 @@ pub struct Args {
     /// region; a point belongs to the innermost shell around it. Shells are labelled 1, 2, … in
     /// order of files and of shells within a file, unless --label says otherwise. Without a
     /// surface, the bundled brain example is meshed. A 2D planar straight-line graph (.poly,
-    /// .node/.edge, or a Dimension 2 .mesh with Edges) is meshed in 2D (see README "2D meshes").
+    /// .node/.edge, or a Dimension 2 .mesh with Edges) is meshed in 2D (see docs/commands.md, "2D meshes").
     surfaces: Vec<PathBuf>,
     /// Labels of one file's shells in order, as FILE=N[,N...] (repeatable); 0 makes a shell a
     /// cavity (not meshed).
@@ -91,7 +91,7 @@ pub struct Args {
     /// Template voxels per smallest edge length (eq. 2.1).
     #[arg(long, value_name = "R", default_value_t = 2.0)]
     resolution: f64,
-    /// Shape of the buffer zone around each node (Euclidean measured better; see README).
+    /// Shape of the buffer zone around each node (Euclidean measured better; see docs/commands.md).
     #[arg(long, value_enum, default_value = "euclidean")]
     zone: ZoneArg,
     /// Largest template size in voxels (one byte each).
