@@ -2,7 +2,7 @@
 
 use crate::memory::{StagePeaks, map_mesh_sized_blocks, release_free_memory};
 use crate::{Common, output, plot, progress::Stage};
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use biotet::mesh::shells::Part;
 use biotet::pipeline::{PipelineOptions, mesh_surface};
 use biotet::quality::{QualityReport, forced};
@@ -241,26 +241,9 @@ pub fn run(a: Args) -> Result<ExitCode> {
         (Some(h), _) => SizeSpec::Uniform(h),
         (None, Some(path)) => {
             let grid = biotet_io::read_scalar_grid_named(path, a.size_field_array.as_deref())?;
-            let (min, max) = (grid.min_value(), grid.max_value());
-            if min.is_nan() || min <= 0.0 {
-                bail!(
-                    "{}: the size field's smallest value is {min}; sizes must be positive",
-                    path.display()
-                );
-            }
-            // An oblique image is meshed in its frame: look the field up in world.
+            // An oblique image is meshed in its frame: the field is looked up in world.
             let to_world = image.as_ref().and_then(|i| i.frame_to_world);
-            SizeSpec::Field {
-                size: Box::new(move |p| {
-                    let mut q = [p];
-                    if let Some(m) = &to_world {
-                        biotet::image::map_points(m, &mut q);
-                    }
-                    grid.value_at(q[0])
-                }),
-                min,
-                max,
-            }
+            SizeSpec::from_grid(grid, to_world).with_context(|| path.display().to_string())?
         }
         (None, None) => SizeSpec::FromSurface { grading: a.grading },
     };
