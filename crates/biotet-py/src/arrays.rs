@@ -3,9 +3,10 @@
 //! vectors into numpy without a copy.
 
 use biotet::mesh::shells::Part;
+use biotet::sizing_grid::ScalarGrid;
 use biotet::{SurfaceMesh, TetMesh};
 use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::{Element, IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
@@ -111,6 +112,41 @@ pub fn surface_from(
             name,
         )),
     }
+}
+
+/// The values of a 3D array `a[i, j, k]` with `i` fastest (the order of `LabelImage` and
+/// `ScalarGrid`) and its shape: one copy, a `memcpy` when the array is Fortran-ordered (as
+/// nibabel's are).
+pub fn volume_from<T: Element + Copy>(a: &PyReadonlyArray3<'_, T>) -> (Vec<T>, [usize; 3]) {
+    let v = a.as_array();
+    let dims = [v.shape()[0], v.shape()[1], v.shape()[2]];
+    // Axes reversed, the logical order is `i` fastest; contiguous when `a` is Fortran-ordered.
+    let t = v.reversed_axes();
+    let values = match t.as_slice() {
+        Some(s) => s.to_vec(),
+        None => t.iter().copied().collect(),
+    };
+    (values, dims)
+}
+
+/// A size field from samples `values[i, j, k]` at `affine · (i, j, k, 1)`: the affine's columns
+/// give each grid axis's direction and spacing.
+pub fn grid_from(
+    values: &PyReadonlyArray3<'_, f64>,
+    affine: &[[f64; 4]; 4],
+) -> PyResult<ScalarGrid> {
+    let (values, dims) = volume_from(values);
+    let spacing: [f64; 3] = std::array::from_fn(|c| {
+        (0..3)
+            .map(|r| affine[r][c] * affine[r][c])
+            .sum::<f64>()
+            .sqrt()
+    });
+    let direction: [[f64; 3]; 3] =
+        std::array::from_fn(|r| std::array::from_fn(|c| affine[r][c] / spacing[c]));
+    let origin = [affine[0][3], affine[1][3], affine[2][3]];
+    ScalarGrid::new(dims, origin, spacing, direction, values)
+        .map_err(|e| PyValueError::new_err(format!("size_field: {e}")))
 }
 
 /// A tet mesh from points, tets and labels (adjacency rebuilt).

@@ -12,6 +12,18 @@ class CoreError(Exception):
 
 _MeshOut = tuple[npt.NDArray[np.float64], npt.NDArray[np.int32], npt.NDArray[np.int32], str]
 
+class _SizeField(TypedDict):
+    path: str | None
+    array: str | None
+    values: npt.NDArray[np.float64] | None
+    affine: Sequence[Sequence[float]] | None
+
+class _ImageOptions(TypedDict):
+    keep: Sequence[int] | None
+    merge: Sequence[tuple[Sequence[int], int]]
+    outside: int
+    min_component_voxels: int
+
 class _MeshOptions(TypedDict):
     size: float | None
     grading: float
@@ -24,6 +36,7 @@ class _MeshOptions(TypedDict):
     steiner: bool
     stages: tuple[bool, bool, bool, bool]
     surface_tolerance: float | None
+    size_field: _SizeField | None
 
 def mesh_arrays(
     points: npt.NDArray[np.float64],
@@ -35,9 +48,19 @@ def mesh_arrays(
     threads: int | None,
     progress: Callable[[str], Any] | None,
 ) -> _MeshOut: ...
+def mesh_image(
+    labels: npt.NDArray[np.uint32],
+    affine: Sequence[Sequence[float]],
+    name: str,
+    image: _ImageOptions,
+    options: _MeshOptions,
+    threads: int | None,
+    progress: Callable[[str], Any] | None,
+) -> _MeshOut: ...
 def mesh_files(
     paths: Sequence[str],
     labels: Sequence[Sequence[int] | None],
+    image: _ImageOptions,
     options: _MeshOptions,
     threads: int | None,
     progress: Callable[[str], Any] | None,
