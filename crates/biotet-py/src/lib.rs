@@ -9,7 +9,9 @@
 mod arrays;
 mod run;
 
-use arrays::{Surface, grid_from, mesh_from, mesh_out, points_from, surface_from, volume_from};
+use arrays::{
+    Ints1, Ints2, Surface, grid_from, mesh_from, mesh_out, points_from, surface_from, volume_from,
+};
 use biotet::check::check as check_mesh;
 use biotet::delaunay::Delaunay;
 use biotet::image::LabelImage;
@@ -26,10 +28,7 @@ use biotet::sizing_grid::ScalarGrid;
 use biotet::smooth::{Boundary, SmoothOptions, smooth};
 use biotet::template::Zone;
 use biotet::{SurfaceMesh, TetMesh};
-use numpy::{
-    PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
-    PyReadonlyArray3,
-};
+use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray2, PyReadonlyArray3};
 use pyo3::prelude::*;
 use run::{Failure, Kind, guarded};
 use serde_json::json;
@@ -388,9 +387,9 @@ fn check_zone(o: &MeshOptions) -> PyResult<()> {
 fn mesh_arrays<'py>(
     py: Python<'py>,
     points: PyReadonlyArray2<'py, f64>,
-    triangles: PyReadonlyArray2<'py, i64>,
+    triangles: Ints2<'py>,
     shell_labels: Option<Vec<u32>>,
-    side_labels: Option<PyReadonlyArray2<'py, i64>>,
+    side_labels: Option<Ints2<'py>>,
     name: String,
     mut options: MeshOptions,
     threads: Option<usize>,
@@ -536,12 +535,12 @@ fn read_surfaces(paths: &[PathBuf], labels: Vec<Option<Vec<u32>>>) -> Result<Sur
 fn check<'py>(
     py: Python<'py>,
     points: PyReadonlyArray2<'py, f64>,
-    tets: PyReadonlyArray2<'py, i64>,
-    labels: PyReadonlyArray1<'py, i64>,
+    tets: Ints2<'py>,
+    labels: Ints1<'py>,
     surface_points: Option<PyReadonlyArray2<'py, f64>>,
-    surface_triangles: Option<PyReadonlyArray2<'py, i64>>,
+    surface_triangles: Option<Ints2<'py>>,
     shell_labels: Option<Vec<u32>>,
-    side_labels: Option<PyReadonlyArray2<'py, i64>>,
+    side_labels: Option<Ints2<'py>>,
     threads: Option<usize>,
 ) -> PyResult<String> {
     let mesh = mesh_from(&points, &tets, &labels)?;
@@ -573,8 +572,8 @@ fn check<'py>(
 fn quality<'py>(
     py: Python<'py>,
     points: PyReadonlyArray2<'py, f64>,
-    tets: PyReadonlyArray2<'py, i64>,
-    labels: PyReadonlyArray1<'py, i64>,
+    tets: Ints2<'py>,
+    labels: Ints1<'py>,
     threads: Option<usize>,
 ) -> PyResult<String> {
     let mesh = mesh_from(&points, &tets, &labels)?;
@@ -608,10 +607,10 @@ fn delaunay<'py>(
 fn recover_surface<'py>(
     py: Python<'py>,
     points: PyReadonlyArray2<'py, f64>,
-    tets: PyReadonlyArray2<'py, i64>,
-    labels: PyReadonlyArray1<'py, i64>,
+    tets: Ints2<'py>,
+    labels: Ints1<'py>,
     surface_points: PyReadonlyArray2<'py, f64>,
-    surface_triangles: PyReadonlyArray2<'py, i64>,
+    surface_triangles: Ints2<'py>,
     steiner: bool,
     keep_outside: bool,
     threads: Option<usize>,
@@ -648,28 +647,34 @@ fn recover_surface<'py>(
     Ok(mesh_out(py, mesh, report))
 }
 
-/// Sliver removal (LAST RESORT) in place of a tet mesh's poor tets.
+/// Sliver removal (LAST RESORT) in place of a tet mesh's poor tets: those under `threshold`
+/// (default 10° for the dihedral angle, 0.2 for q, as `biotet improve`).
 #[pyfunction]
-#[pyo3(signature = (points, tets, labels, threshold=10.0, metric="dihedral", threads=None))]
+#[pyo3(signature = (points, tets, labels, threshold=None, metric="dihedral", threads=None))]
 #[allow(clippy::too_many_arguments)]
 fn improve_mesh<'py>(
     py: Python<'py>,
     points: PyReadonlyArray2<'py, f64>,
-    tets: PyReadonlyArray2<'py, i64>,
-    labels: PyReadonlyArray1<'py, i64>,
-    threshold: f64,
+    tets: Ints2<'py>,
+    labels: Ints1<'py>,
+    threshold: Option<f64>,
     metric: &str,
     threads: Option<usize>,
 ) -> PyResult<MeshOut<'py>> {
-    let metric = match metric {
-        "dihedral" => Metric::Dihedral,
-        "q" => Metric::Q,
+    let (metric, threshold) = match metric {
+        "dihedral" => (Metric::Dihedral, threshold.unwrap_or(10.0)),
+        "q" => (Metric::Q, threshold.unwrap_or(0.2)),
         m => {
             return Err(pyo3::exceptions::PyValueError::new_err(format!(
                 "metric must be 'dihedral' or 'q', not {m:?}"
             )));
         }
     };
+    if !threshold.is_finite() || threshold <= 0.0 {
+        return Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "threshold {threshold}: expected a positive number"
+        )));
+    }
     let mut mesh = mesh_from(&points, &tets, &labels)?;
     let (mesh, report) = guarded(py, threads, move || {
         let opts = ImproveOptions {
@@ -686,19 +691,25 @@ fn improve_mesh<'py>(
 /// Solid-angle smoothing of a tet mesh (surface fixed, or sliding on the given surface).
 #[pyfunction]
 #[pyo3(signature = (points, tets, labels, surface_points=None, surface_triangles=None,
-    slide=false, max_sweeps=None, threads=None))]
+    slide=false, max_sweeps=None, feature_angle=45.0, threads=None))]
 #[allow(clippy::too_many_arguments)]
 fn smooth_mesh<'py>(
     py: Python<'py>,
     points: PyReadonlyArray2<'py, f64>,
-    tets: PyReadonlyArray2<'py, i64>,
-    labels: PyReadonlyArray1<'py, i64>,
+    tets: Ints2<'py>,
+    labels: Ints1<'py>,
     surface_points: Option<PyReadonlyArray2<'py, f64>>,
-    surface_triangles: Option<PyReadonlyArray2<'py, i64>>,
+    surface_triangles: Option<Ints2<'py>>,
     slide: bool,
     max_sweeps: Option<usize>,
+    feature_angle: f64,
     threads: Option<usize>,
 ) -> PyResult<MeshOut<'py>> {
+    if !(0.0..=180.0).contains(&feature_angle) {
+        return Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "feature_angle {feature_angle}: expected degrees between 0 and 180"
+        )));
+    }
     let mut mesh = mesh_from(&points, &tets, &labels)?;
     let surface = match (&surface_points, &surface_triangles) {
         (Some(p), Some(t)) => Some(surface_from(p, t, None, None, "surface".into())?),
@@ -712,6 +723,7 @@ fn smooth_mesh<'py>(
             } else {
                 Boundary::Fixed
             },
+            feature_angle_deg: feature_angle,
             ..SmoothOptions::default()
         };
         if let Some(n) = max_sweeps {
@@ -755,8 +767,8 @@ fn write_tet_mesh<'py>(
     py: Python<'py>,
     path: PathBuf,
     points: PyReadonlyArray2<'py, f64>,
-    tets: PyReadonlyArray2<'py, i64>,
-    labels: PyReadonlyArray1<'py, i64>,
+    tets: Ints2<'py>,
+    labels: Ints1<'py>,
 ) -> PyResult<Vec<PathBuf>> {
     let mesh = mesh_from(&points, &tets, &labels)?;
     guarded(py, None, move || {

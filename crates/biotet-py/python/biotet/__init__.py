@@ -121,24 +121,36 @@ def _progress(progress: Callable[[str], Any] | None) -> Callable[[str], Any] | N
 
 
 def _points(a: Any, what: str = "points") -> np.ndarray:
-    p = np.ascontiguousarray(a, dtype=np.float64)
+    """Points as float64 (n, 3), passed to biotet in place when they are float64 already."""
+    p = np.asarray(a, dtype=np.float64)
     if p.ndim != 2 or p.shape[1] != 3:
         raise ValueError(f"{what} must have shape (n, 3), not {p.shape}")
     return p
 
 
+_INDEX_TYPES = (np.dtype(np.int32), np.dtype(np.int64))
+
+
 def _indices(a: Any, width: int, what: str) -> np.ndarray:
+    """Index rows as int32 or int64 (n, width), passed in place when they are either (biotet
+    returns int32); other integer types are converted once."""
     x = np.asarray(a)
     if x.size and not np.issubdtype(x.dtype, np.integer):
         raise ValueError(f"{what} must hold integers, not {x.dtype}")
-    x = np.ascontiguousarray(x, dtype=np.int64)
+    if x.dtype not in _INDEX_TYPES:
+        x = x.astype(np.int64)
     if x.ndim != 2 or x.shape[1] != width:
         raise ValueError(f"{what} must have shape (n, {width}), not {x.shape}")
     return x
 
 
 def _labels(a: Any, n: int) -> np.ndarray:
-    x = np.ascontiguousarray(a, dtype=np.int64).reshape(-1)
+    """Labels as int32 or int64 (n,), passed in place when they are either."""
+    x = np.asarray(a).reshape(-1)
+    if x.size and not np.issubdtype(x.dtype, np.integer):
+        raise ValueError(f"labels must hold integers, not {x.dtype}")
+    if x.dtype not in _INDEX_TYPES:
+        x = x.astype(np.int64)
     if x.shape[0] != n:
         raise ValueError(f"labels has {x.shape[0]} entries for {n} tets")
     return x
@@ -623,23 +635,25 @@ def recover(mesh: TetMesh, surface: Surface | tuple[Any, Any], *, steiner: bool 
                       keep_outside=keep_outside, threads=threads))
 
 
-def improve(mesh: TetMesh, *, threshold: float = 10.0, metric: str = "dihedral",
+def improve(mesh: TetMesh, *, threshold: float | None = None, metric: str = "dihedral",
             threads: int | None = None) -> TetMesh:
-    """Remove slivers by refilling their cavities (LAST RESORT): tets whose smallest dihedral
-    angle (``metric="dihedral"``, degrees) or q (``metric="q"``) is under ``threshold``. Points
-    and surface are kept."""
+    """Remove slivers by refilling their cavities (LAST RESORT), as ``biotet improve``: tets
+    whose smallest dihedral angle (``metric="dihedral"``, degrees, default threshold 10) or q
+    (``metric="q"``, default threshold 0.2) is under ``threshold``. Points and surface are
+    kept."""
     return _tet(_call(_core.improve_mesh, *_mesh_arrays(mesh), threshold=threshold,
                       metric=metric, threads=threads))
 
 
 def smooth(mesh: TetMesh, surface: Surface | tuple[Any, Any] | None = None, *,
-           slide: bool = False, max_sweeps: int | None = None,
+           slide: bool = False, max_sweeps: int | None = None, feature_angle: float = 45.0,
            threads: int | None = None) -> TetMesh:
-    """Raise the smallest solid angles by moving nodes (the surface fixed, or sliding on
-    ``surface`` with ``slide=True``)."""
+    """Raise the smallest solid angles by moving nodes, as ``biotet smooth``: the surface and
+    interfaces fixed, or with ``slide=True`` sliding on ``surface`` (feature edges sharper than
+    ``feature_angle`` degrees, and corners, stay). ``max_sweeps`` defaults to 10."""
     sp, st = _surface_arrays(surface)
     return _tet(_call(_core.smooth_mesh, *_mesh_arrays(mesh), sp, st, slide=slide,
-                      max_sweeps=max_sweeps, threads=threads))
+                      max_sweeps=max_sweeps, feature_angle=feature_angle, threads=threads))
 
 
 _SURFACE_ONLY = (".stl", ".obj", ".off", ".ply")

@@ -10,6 +10,7 @@ __version__: str
 class CoreError(Exception):
     """A failure inside biotet: args are (kind, message, triangles)."""
 
+_Ints = npt.NDArray[np.int32] | npt.NDArray[np.int64]
 _MeshOut = tuple[npt.NDArray[np.float64], npt.NDArray[np.int32], npt.NDArray[np.int32], str]
 
 class _SizeField(TypedDict):
@@ -40,9 +41,9 @@ class _MeshOptions(TypedDict):
 
 def mesh_arrays(
     points: npt.NDArray[np.float64],
-    triangles: npt.NDArray[np.int64],
+    triangles: _Ints,
     shell_labels: Sequence[int] | None,
-    side_labels: npt.NDArray[np.int64] | None,
+    side_labels: _Ints | None,
     name: str,
     options: _MeshOptions,
     threads: int | None,
@@ -67,47 +68,48 @@ def mesh_files(
 ) -> _MeshOut: ...
 def check(
     points: npt.NDArray[np.float64],
-    tets: npt.NDArray[np.int64],
-    labels: npt.NDArray[np.int64],
+    tets: _Ints,
+    labels: _Ints,
     surface_points: npt.NDArray[np.float64] | None = None,
-    surface_triangles: npt.NDArray[np.int64] | None = None,
+    surface_triangles: _Ints | None = None,
     shell_labels: Sequence[int] | None = None,
-    side_labels: npt.NDArray[np.int64] | None = None,
+    side_labels: _Ints | None = None,
     threads: int | None = None,
 ) -> str: ...
 def quality(
     points: npt.NDArray[np.float64],
-    tets: npt.NDArray[np.int64],
-    labels: npt.NDArray[np.int64],
+    tets: _Ints,
+    labels: _Ints,
     threads: int | None = None,
 ) -> str: ...
 def delaunay(points: npt.NDArray[np.float64], threads: int | None = None) -> _MeshOut: ...
 def recover_surface(
     points: npt.NDArray[np.float64],
-    tets: npt.NDArray[np.int64],
-    labels: npt.NDArray[np.int64],
+    tets: _Ints,
+    labels: _Ints,
     surface_points: npt.NDArray[np.float64],
-    surface_triangles: npt.NDArray[np.int64],
+    surface_triangles: _Ints,
     steiner: bool = True,
     keep_outside: bool = False,
     threads: int | None = None,
 ) -> _MeshOut: ...
 def improve_mesh(
     points: npt.NDArray[np.float64],
-    tets: npt.NDArray[np.int64],
-    labels: npt.NDArray[np.int64],
-    threshold: float = 10.0,
+    tets: _Ints,
+    labels: _Ints,
+    threshold: float | None = None,
     metric: str = "dihedral",
     threads: int | None = None,
 ) -> _MeshOut: ...
 def smooth_mesh(
     points: npt.NDArray[np.float64],
-    tets: npt.NDArray[np.int64],
-    labels: npt.NDArray[np.int64],
+    tets: _Ints,
+    labels: _Ints,
     surface_points: npt.NDArray[np.float64] | None = None,
-    surface_triangles: npt.NDArray[np.int64] | None = None,
+    surface_triangles: _Ints | None = None,
     slide: bool = False,
     max_sweeps: int | None = None,
+    feature_angle: float = 45.0,
     threads: int | None = None,
 ) -> _MeshOut: ...
 def read_tet_mesh(path: str) -> _MeshOut: ...
@@ -117,6 +119,6 @@ def read_surface(
 def write_tet_mesh(
     path: str,
     points: npt.NDArray[np.float64],
-    tets: npt.NDArray[np.int64],
-    labels: npt.NDArray[np.int64],
+    tets: _Ints,
+    labels: _Ints,
 ) -> list[str]: ...
