@@ -4,7 +4,7 @@
     pip install ./crates/biotet-py tetgen            # (pytetwild too, if it installs)
     cargo build --release -p biotet-cli
     python3 scripts/bench_python.py [--repeat 3] [--surface tests/data/brain_20k.stl] [--wheel WHEEL]
-        [--pip-install] [--pip-source]
+        [--pip-install] [--pip-source] [--cases biotet,cli,tetgen,pytetwild,serial,parallel]
 
 Each figure is measured in a child process (its own peak RSS), the cases alternating, `--repeat`
 times; medians are printed:
@@ -47,6 +47,8 @@ import biotet
 s = biotet.read_surface(surface)
 pts, tris = np.ascontiguousarray(s.points), np.ascontiguousarray(s.triangles)
 rss0 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+cpu = lambda: sum(resource.getrusage(resource.RUSAGE_SELF)[:2])
+c0 = cpu()
 t = time.perf_counter()
 out = {}
 if case == "biotet":
@@ -70,6 +72,7 @@ elif case == "parallel":
     [x.start() for x in ts]
     [x.join() for x in ts]
 out["seconds"] = time.perf_counter() - t
+out["cpu_seconds"] = cpu() - c0
 out["peak_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 out["peak_above_start_mb"] = (resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - rss0) / 1024
 print(json.dumps(out))
@@ -128,8 +131,10 @@ def main() -> None:
                     help="time `pip install WHEEL` into a new virtual environment")
     ap.add_argument("--pip-source", action="store_true",
                     help="time `pip install ./crates/biotet-py` with a cold cargo target")
+    ap.add_argument("--cases", default="biotet,cli,tetgen,pytetwild,serial,parallel",
+                    help="which cases to run, comma-separated")
     a = ap.parse_args()
-    cases = ["biotet", "cli", "tetgen", "pytetwild", "serial", "parallel"]
+    cases = a.cases.split(",")
     runs: dict[str, list[dict]] = {c: [] for c in cases}
     for _ in range(a.repeat):
         for c in cases:
@@ -149,13 +154,19 @@ def main() -> None:
         printed = rs[0].get("stdout_lines", "")
         print(f"| {c} | {med('seconds'):.2f} | {tets} | {med('peak_mb'):.0f} | "
               f"{med('peak_above_start_mb'):.0f} | {printed} |")
-    if runs["pytetwild"]:
+    if runs.get("pytetwild"):
         print(f"pytetwild's points: {runs['pytetwild'][0].get('points_dtype')}")
-    if runs["serial"] and runs["parallel"]:
+    if runs.get("serial") and runs.get("parallel"):
         s = statistics.median(r["seconds"] for r in runs["serial"])
         p = statistics.median(r["seconds"] for r in runs["parallel"])
         print(f"two meshings in two threads: {s / p:.2f}× faster than one after the other")
-    if runs["biotet"] and runs["cli"]:
+        par = runs["parallel"]
+        busy = statistics.median(r["cpu_seconds"] / r["seconds"] for r in par)
+        print(f"  CPU seconds per wall second in the two threads: {busy:.2f} (at most 1 with "
+              "the GIL held; 2 when both threads have a core)")
+    load = os.getloadavg()
+    print(f"load average at the end: {load[0]:.2f} / {load[1]:.2f} / {load[2]:.2f}")
+    if runs.get("biotet") and runs.get("cli"):
         b = statistics.median(r["seconds"] for r in runs["biotet"])
         c = statistics.median(r["seconds"] for r in runs["cli"])
         print(f"binding / CLI meshing time: {b / c:.2f}")
