@@ -61,7 +61,11 @@ def test_affine_spacing_and_dtypes_give_the_same_mesh():
     ):
         b = biotet.mesh_image(lab, **variant)
         assert np.array_equal(a.points, b.points) and np.array_equal(a.tets, b.tets)
-    for data in (lab.astype(np.int64), lab.astype(np.float32), np.ascontiguousarray(lab)):
+    spaced = np.zeros((2 * lab.shape[0],) + lab.shape[1:], lab.dtype)
+    spaced[::2] = lab
+    reversed_view = np.ascontiguousarray(lab[::-1])[::-1]  # negative strides, same values
+    for data in (lab.astype(np.int64), lab.astype(np.float32), np.ascontiguousarray(lab),
+                 spaced[::2], reversed_view, lab.astype(np.dtype(">u4"))):
         b = biotet.mesh_image(data, spacing=SPACING, origin=ORIGIN)
         assert np.array_equal(a.tets, b.tets) and np.array_equal(a.labels, b.labels)
 
