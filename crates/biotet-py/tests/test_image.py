@@ -236,3 +236,18 @@ def test_bad_image_files(cli, tmp_path):
     with pytest.raises(FileNotFoundError) as e:
         biotet.mesh(*cube(), size_field=tmp_path / "none.vti")
     assert "none.vti" in str(e.value)
+
+
+def test_the_report_is_the_cli_json(cli, tmp_path):
+    import json
+
+    src = IMAGES / "label_uint8.mha"
+    r = run_cli(cli, "mesh", src, "--json", "--merge", "2,41=1", "-o", tmp_path / "m.vtu")
+    assert r.returncode == 0, r.stderr
+    want = json.loads(r.stdout)
+    got = biotet.mesh_file(src, merge={2: 1, 41: 1}).report
+    untimed = lambda d: {k: v for k, v in d.items() if not k.startswith("seconds")}
+    assert untimed(got["image"]) == untimed(want["image"])
+    assert got["image_regions"] == want["image_regions"]
+    assert got["quality"] == want["quality"] and got["forcing"] == want["forcing"]
+    assert [row["label"] for row in got["image_regions"]] == [1, 17]
