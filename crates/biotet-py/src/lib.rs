@@ -5,6 +5,11 @@
 //!
 //! Inputs are borrowed read-only from numpy and copied once into the library's types (the
 //! library owns its arrays); outputs are moved into numpy without a copy.
+//!
+//! Meshing follows `biotet mesh` step for step, through the same library calls, so the bytes
+//! written are the CLI's: a surface validated (shells assembled, or side labels resolved), or a
+//! label image through `image::surface::labelled_surface` with its labels renumbered for the
+//! template and put back after; sizes from `SizeSpec::from_grid` for a size field.
 
 mod arrays;
 mod run;
