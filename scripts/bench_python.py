@@ -68,19 +68,9 @@ elif case == "serial":
     for _ in range(2):
         biotet.mesh(pts, tris, threads=1)
 elif case == "parallel":
-    spans = []
-    def one():
-        stamps = []
-        biotet.mesh(pts, tris, threads=1, progress=lambda stage: stamps.append(time.perf_counter()))
-        spans.append((stamps[0], stamps[-1]))
-    ts = [threading.Thread(target=one) for _ in range(2)]
+    ts = [threading.Thread(target=biotet.mesh, args=(pts, tris), kwargs={"threads": 1}) for _ in range(2)]
     [x.start() for x in ts]
     [x.join() for x in ts]
-    # From the first stage to the last of each call (the progress calls come from inside the
-    # computation): with the GIL held through a call, the other call's stages could only start
-    # after this one's ended; overlapping spans show the release whatever the machine's load.
-    (a0, a1), (b0, b1) = spans
-    out["overlap"] = max(0.0, min(a1, b1) - max(a0, b0)) / min(a1 - a0, b1 - b0)
 out["seconds"] = time.perf_counter() - t
 out["cpu_seconds"] = cpu() - c0
 out["peak_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
@@ -174,9 +164,6 @@ def main() -> None:
         busy = statistics.median(r["cpu_seconds"] / r["seconds"] for r in par)
         print(f"  CPU seconds per wall second in the two threads: {busy:.2f} (at most 1 with "
               "the GIL held; 2 when both threads have a core)")
-        overlap = statistics.median(r["overlap"] for r in par)
-        print(f"  the two meshings (first stage to last) overlap for {100 * overlap:.0f}% of the "
-              "shorter one (0 with the GIL held through a call)")
     load = os.getloadavg()
     print(f"load average at the end: {load[0]:.2f} / {load[1]:.2f} / {load[2]:.2f}")
     if runs.get("biotet") and runs.get("cli"):
