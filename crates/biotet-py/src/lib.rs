@@ -452,6 +452,60 @@ fn mesh_image<'py>(
     Ok(mesh_out(py, mesh, report.to_string()))
 }
 
+/// The labelled surface of a label image in world coordinates, as `biotet surface IMAGE`
+/// writes it.
+fn extracted(img: LabelImage, opts: &ImageOptions, name: String) -> Result<SurfaceMesh, Failure> {
+    let p = prepare_image(img, opts, name, 0.0, &|_| {})?;
+    let mut s = p.surface;
+    if let Some(m) = p.image.and_then(|i| i.frame_to_world) {
+        biotet::image::map_points(&m, &mut s.points);
+    }
+    Ok(s)
+}
+
+/// The labelled surface of a label volume (see `biotet.surface_extract`): `labels[i, j, k]` is
+/// the label of the voxel centred at `affine · (i, j, k, 1)`.
+#[pyfunction]
+#[pyo3(signature = (labels, affine, name, image))]
+fn surface_image<'py>(
+    py: Python<'py>,
+    labels: PyReadonlyArray3<'py, u32>,
+    affine: [[f64; 4]; 4],
+    name: String,
+    image: ImageOptions,
+) -> PyResult<SurfaceOut<'py>> {
+    let (values, dims) = volume_from(&labels);
+    let img = LabelImage::new(dims, affine, values)
+        .map_err(|e| pyo3::exceptions::PyValueError::new_err(format!("labels: {e}")))?;
+    let s = guarded(py, None, move || extracted(img, &image, name))?;
+    Ok(arrays::surface_out(py, s))
+}
+
+/// The labelled surface of a label image file (see `biotet.surface_extract`).
+#[pyfunction]
+#[pyo3(signature = (path, image))]
+fn surface_image_file<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    image: ImageOptions,
+) -> PyResult<SurfaceOut<'py>> {
+    let s = guarded(py, None, move || {
+        if !biotet_io::is_label_image(&path) {
+            return Err(Failure::new(
+                Kind::File,
+                format!(
+                    "{}: not a label image ({})",
+                    path.display(),
+                    biotet_io::image::IMAGE_EXTENSIONS
+                ),
+            ));
+        }
+        let img = biotet_io::read_label_image(&path).map_err(Failure::io)?;
+        extracted(img, &image, path.display().to_string())
+    })?;
+    Ok(arrays::surface_out(py, s))
+}
+
 /// Mesh the volume inside the closed surfaces in files (see `biotet.mesh_file`).
 #[pyfunction]
 #[pyo3(signature = (paths, labels, image, options, threads, progress))]
@@ -789,6 +843,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(mesh_arrays, m)?)?;
     m.add_function(wrap_pyfunction!(mesh_files, m)?)?;
     m.add_function(wrap_pyfunction!(mesh_image, m)?)?;
+    m.add_function(wrap_pyfunction!(surface_image, m)?)?;
+    m.add_function(wrap_pyfunction!(surface_image_file, m)?)?;
     m.add_function(wrap_pyfunction!(check, m)?)?;
     m.add_function(wrap_pyfunction!(quality, m)?)?;
     m.add_function(wrap_pyfunction!(delaunay, m)?)?;

@@ -251,3 +251,31 @@ def test_the_report_is_the_cli_json(cli, tmp_path):
     assert got["image_regions"] == want["image_regions"]
     assert got["quality"] == want["quality"] and got["forcing"] == want["forcing"]
     assert [row["label"] for row in got["image_regions"]] == [1, 17]
+
+
+def test_the_mesh_conforms_to_the_extracted_surface(cli, tmp_path):
+    lab = nested_balls()
+    s = biotet.surface_extract(lab, spacing=SPACING, origin=ORIGIN)
+    assert set(np.unique(s.sides)) == {0, 7, 30}
+    m = biotet.mesh_image(lab, spacing=SPACING, origin=ORIGIN)
+    c = biotet.check(m, s)
+    assert c["valid"] and c["surface"]["n_missing"] == 0, c["problems"]
+    # Another image's surface does not fit this mesh.
+    other = biotet.surface_extract(nested_balls(values=(30, 8)), spacing=SPACING, origin=ORIGIN)
+    assert not biotet.check(m, other)["valid"]
+    # An oblique file: the CLI's surface, point for point, and its mesh conforms to it.
+    src = IMAGES / "label_uint8.mha"
+    out = tmp_path / "s.ply"
+    r = run_cli(cli, "surface", src, "-o", out, "--quiet")
+    assert r.returncode == 0, r.stderr
+    want = biotet.read_surface(out)
+    got = biotet.surface_extract(src)
+    np.testing.assert_array_equal(got.points, want.points)
+    np.testing.assert_array_equal(got.triangles, want.triangles)
+    np.testing.assert_array_equal(got.sides, want.sides)
+    c = biotet.check(biotet.mesh_file(src), got)
+    assert c["valid"] and c["surface"]["n_missing"] == 0, c["problems"]
+    with pytest.raises(ValueError, match="own geometry"):
+        biotet.surface_extract(src, spacing=(2.0, 2.0, 2.0))
+    with pytest.raises(biotet.BiotetFileError, match="not a label image"):
+        biotet.surface_extract(IMAGES / "vtk_ascii.vtu")

@@ -41,6 +41,7 @@ __all__ = [
     "mesh",
     "mesh_image",
     "mesh_file",
+    "surface_extract",
     "recover",
     "improve",
     "smooth",
@@ -573,6 +574,37 @@ def mesh_file(
         _size_field(size_field, size_field_array),
     )
     return _tet(_call(_core.mesh_files, ps, per_file, img, o, threads, _progress(progress)))
+
+
+def surface_extract(
+    image: Any,
+    spacing: Sequence[float] = (1.0, 1.0, 1.0),
+    origin: Sequence[float] = (0.0, 0.0, 0.0),
+    affine: Any = None,
+    *,
+    keep_labels: Iterable[int] | None = None,
+    merge: Mapping[int, int] | None = None,
+    outside: int = 0,
+    min_component_voxels: int = 0,
+    name: str = "image",
+) -> Surface:
+    """The labelled surface of a label image, as ``biotet surface IMAGE -o OUT`` writes it: every
+    voxel face between two labels (after the label options, as in :func:`mesh_image`) as two
+    triangles whose ``sides`` are the labels behind and in front, each region closed and
+    manifold, in world coordinates. ``image`` is a label image file or a numpy label volume
+    with its ``spacing``/``origin`` or ``affine``. It is the surface :func:`mesh_image` and
+    :func:`mesh_file` keep exactly, so ``check(mesh, surface)`` verifies that a mesh of the
+    image conforms to it."""
+    img = _image_options(keep_labels, merge, outside, min_component_voxels)
+    if isinstance(image, (str, os.PathLike)):
+        if (tuple(map(float, spacing)) != (1.0, 1.0, 1.0)
+                or tuple(map(float, origin)) != (0.0, 0.0, 0.0) or affine is not None):
+            raise ValueError("surface_extract: a file holds its own geometry; give no "
+                             "spacing, origin or affine")
+        return Surface(*_call(_core.surface_image_file, os.fspath(image), img))
+    vol = _label_volume(image)
+    m = _affine(spacing, origin, affine, "surface_extract")
+    return Surface(*_call(_core.surface_image, vol, m, name, img))
 
 
 def _surface_arrays(surface: Surface | tuple[Any, Any] | None) -> tuple[Any, Any]:

@@ -58,6 +58,15 @@ def mesh_image(
     threads: int | None,
     progress: Callable[[str], Any] | None,
 ) -> _MeshOut: ...
+def surface_image(
+    labels: npt.NDArray[np.uint32],
+    affine: Sequence[Sequence[float]],
+    name: str,
+    image: _ImageOptions,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int32], npt.NDArray[np.int32]]: ...
+def surface_image_file(
+    path: str, image: _ImageOptions
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int32], npt.NDArray[np.int32]]: ...
 def mesh_files(
     paths: Sequence[str],
     labels: Sequence[Sequence[int] | None],
