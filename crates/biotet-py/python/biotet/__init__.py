@@ -1,21 +1,22 @@
-"""biotet: tetrahedral meshes of anatomy from closed triangulated surfaces.
+"""biotet: tetrahedral meshes of anatomy from closed triangulated surfaces and label images.
 
-Every input triangle is kept exactly (label volumes become such surfaces, one voxel face at a
-time), interior nodes are deployed on a template, boundary
-recovery and sliver removal use the LAST RESORT search, and solid-angle smoothing finishes the
-mesh. numpy arrays go in and out; the GIL is released while biotet computes, so threads and Dask
-workers mesh in parallel.
+Every input triangle is kept exactly (a label volume becomes such a surface, two triangles per
+voxel face between labels), interior nodes are deployed on a template, boundary recovery and
+sliver removal use the LAST RESORT search, and solid-angle smoothing finishes the mesh. numpy
+arrays go in and out; the GIL is released while biotet computes, so threads and Dask workers
+mesh in parallel.
 
 >>> import biotet, numpy as np
 >>> m = biotet.mesh_file("brain.stl")                    # doctest: +SKIP
 >>> m.points.shape, m.tets.shape, m.report["quality"]["min_dihedral_deg"]  # doctest: +SKIP
+>>> seg = biotet.mesh_image(labels, affine=img.affine)   # doctest: +SKIP
 
 Functions mirror the command-line tool: :func:`mesh`, :func:`mesh_image`, :func:`mesh_file`,
-:func:`recover`,
-:func:`improve`, :func:`smooth`, :func:`check`, :func:`quality`, :func:`delaunay`,
-:func:`read`, :func:`write`. Errors are :class:`InvalidSurfaceError` (a ``ValueError``),
-:class:`MeshingError`, and ``OSError`` subclasses for files. Progress goes to the ``biotet``
-logger (level INFO) or to a ``progress`` callable.
+:func:`surface_extract`, :func:`recover`, :func:`improve`, :func:`smooth`, :func:`check`,
+:func:`quality`, :func:`delaunay`, :func:`read`, :func:`write`. Errors are
+:class:`InvalidSurfaceError` (a ``ValueError``), :class:`MeshingError`, ``ValueError`` for bad
+arguments, and ``OSError`` subclasses for files, with the CLI's messages. Progress goes to the
+``biotet`` logger (level INFO) or to a ``progress`` callable; nothing is printed.
 """
 
 from __future__ import annotations
