@@ -83,6 +83,9 @@ struct MeshOptions {
     steiner: bool,
     stages: [bool; 4],
     surface_tolerance: Option<f64>,
+    surface_feature_angle: f64,
+    surface_rounds: usize,
+    adaptive_size: bool,
     size_field: Option<SizeFieldIn>,
 }
 
@@ -245,6 +248,9 @@ fn mesh_with(
             let so = biotet::surface::SurfaceOptions {
                 tolerance: d,
                 edge_length: o.size,
+                feature_angle_deg: o.surface_feature_angle,
+                rounds: o.surface_rounds,
+                adaptive: o.adaptive_size,
                 ..Default::default()
             };
             let (s, r) = biotet::surface::improve(&surface, &so)

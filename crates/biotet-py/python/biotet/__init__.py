@@ -247,6 +247,7 @@ def _mesh_options(
     steiner: bool,
     stages: tuple[bool, bool, bool, bool],
     surface_tolerance: float | None,
+    surface: tuple[float, int, bool],
     size_field: dict | None,
 ) -> dict:
     """The options of ``mesh``, ``mesh_image`` and ``mesh_file`` as the native module reads
@@ -263,6 +264,9 @@ def _mesh_options(
         steiner=steiner,
         stages=stages,
         surface_tolerance=surface_tolerance,
+        surface_feature_angle=float(surface[0]),
+        surface_rounds=int(surface[1]),
+        adaptive_size=bool(surface[2]),
         size_field=size_field,
     )
 
@@ -398,6 +402,9 @@ def mesh(
     smooth: bool = True,
     polish: bool = True,
     surface_tolerance: float | None = None,
+    surface_feature_angle: float = 30.0,
+    surface_rounds: int = 6,
+    adaptive_size: bool = False,
     threads: int | None = None,
     progress: Callable[[str], Any] | None = None,
     name: str = "arrays",
@@ -417,7 +424,8 @@ def mesh(
     (``--no-steiner``); ``recover``/``improve``/``smooth``/``polish`` switch stages off.
     ``surface_tolerance=D`` first remeshes the surface within a two-sided Hausdorff distance D
     (``--surface-tolerance D``; reported in ``report["surface"]``): fewer slivers, the surface
-    no longer kept exactly. ``threads``: worker threads (default one per core; the result does
+    no longer kept exactly; ``surface_feature_angle``, ``surface_rounds`` and ``adaptive_size``
+    are that stage's ``--feature-angle``, ``--surface-rounds`` and ``--adaptive-size``. ``threads``: worker threads (default one per core; the result does
     not depend on it). ``progress``: called with each stage's name (default: the ``biotet``
     logger at level INFO).
 
@@ -431,6 +439,7 @@ def mesh(
     o = _mesh_options(
         size, grading, min_size, max_size, region_sizes, resolution, zone, max_voxels,
         steiner, (recover, improve, smooth, polish), surface_tolerance,
+        (surface_feature_angle, surface_rounds, adaptive_size),
         _size_field(size_field, size_field_array),
     )
     return _tet(_call(_core.mesh_arrays, v, f, shell, s, name, o, threads, _progress(progress)))
@@ -462,6 +471,9 @@ def mesh_image(
     smooth: bool = True,
     polish: bool = True,
     surface_tolerance: float | None = None,
+    surface_feature_angle: float = 30.0,
+    surface_rounds: int = 6,
+    adaptive_size: bool = False,
     threads: int | None = None,
     progress: Callable[[str], Any] | None = None,
     name: str = "image",
@@ -489,7 +501,8 @@ def mesh_image(
     (``--no-steiner``); ``recover``/``improve``/``smooth``/``polish`` switch stages off.
     ``surface_tolerance=D`` first remeshes the surface within a two-sided Hausdorff distance D
     (``--surface-tolerance D``; reported in ``report["surface"]``): fewer slivers, the surface
-    no longer kept exactly. ``threads``: worker threads (default one per core; the result does
+    no longer kept exactly; ``surface_feature_angle``, ``surface_rounds`` and ``adaptive_size``
+    are that stage's ``--feature-angle``, ``--surface-rounds`` and ``--adaptive-size``. ``threads``: worker threads (default one per core; the result does
     not depend on it). ``progress``: called with each stage's name (default: the ``biotet``
     logger at level INFO). A bare array as ``size_field`` is taken on the image's own grid.
 
@@ -503,6 +516,7 @@ def mesh_image(
     o = _mesh_options(
         size, grading, min_size, max_size, region_sizes, resolution, zone, max_voxels,
         steiner, (recover, improve, smooth, polish), surface_tolerance,
+        (surface_feature_angle, surface_rounds, adaptive_size),
         _size_field(size_field, size_field_array, m),
     )
     return _tet(_call(_core.mesh_image, vol, m, name, img, o, threads, _progress(progress)))
@@ -532,6 +546,9 @@ def mesh_file(
     smooth: bool = True,
     polish: bool = True,
     surface_tolerance: float | None = None,
+    surface_feature_angle: float = 30.0,
+    surface_rounds: int = 6,
+    adaptive_size: bool = False,
     threads: int | None = None,
     progress: Callable[[str], Any] | None = None,
 ) -> TetMesh:
@@ -552,7 +569,8 @@ def mesh_file(
     (``--no-steiner``); ``recover``/``improve``/``smooth``/``polish`` switch stages off.
     ``surface_tolerance=D`` first remeshes the surface within a two-sided Hausdorff distance D
     (``--surface-tolerance D``; reported in ``report["surface"]``): fewer slivers, the surface
-    no longer kept exactly. ``threads``: worker threads (default one per core; the result does
+    no longer kept exactly; ``surface_feature_angle``, ``surface_rounds`` and ``adaptive_size``
+    are that stage's ``--feature-angle``, ``--surface-rounds`` and ``--adaptive-size``. ``threads``: worker threads (default one per core; the result does
     not depend on it). ``progress``: called with each stage's name (default: the ``biotet``
     logger at level INFO).
 
@@ -572,6 +590,7 @@ def mesh_file(
     o = _mesh_options(
         size, grading, min_size, max_size, region_sizes, resolution, zone, max_voxels,
         steiner, (recover, improve, smooth, polish), surface_tolerance,
+        (surface_feature_angle, surface_rounds, adaptive_size),
         _size_field(size_field, size_field_array),
     )
     return _tet(_call(_core.mesh_files, ps, per_file, img, o, threads, _progress(progress)))

@@ -37,6 +37,9 @@ class _MeshOptions(TypedDict):
     steiner: bool
     stages: tuple[bool, bool, bool, bool]
     surface_tolerance: float | None
+    surface_feature_angle: float
+    surface_rounds: int
+    adaptive_size: bool
     size_field: _SizeField | None
 
 def mesh_arrays(
