@@ -80,7 +80,11 @@ print(json.dumps(out))
 
 
 def child(case: str, surface: str) -> dict | None:
-    r = subprocess.run([sys.executable, "-c", CHILD, case, surface], capture_output=True, text=True)
+    # In a scratch directory: fTetWild (pytetwild) leaves a __tracked_surface.stl in its working
+    # directory.
+    with tempfile.TemporaryDirectory() as scratch:
+        r = subprocess.run([sys.executable, "-c", CHILD, case, os.path.abspath(surface)],
+                           capture_output=True, text=True, cwd=scratch)
     if r.returncode != 0:
         print(f"  {case}: failed: {r.stderr.strip().splitlines()[-1] if r.stderr.strip() else r.returncode}",
               file=sys.stderr)
