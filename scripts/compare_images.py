@@ -110,7 +110,8 @@ def run_nets(image, tmp):
     base = os.path.join(tmp, "nets")
     wall, peak, r = run_binary([sys.executable, "-c", CHILD, image, base])
     if r.returncode != 0:
-        raise RuntimeError((r.stderr or r.stdout).strip()[-300:])
+        err = "\n".join(l for l in (r.stderr or "").splitlines() if not l.startswith("PEAK "))
+        raise RuntimeError((err or r.stdout).strip()[-300:] or f"exit status {r.returncode}")
     j = json.loads(r.stdout.strip().splitlines()[-1])
     return base + ".node", {"seconds": j["seconds"], "wall": wall, "peak_mb": peak / 1024 if peak else None}
 
