@@ -307,3 +307,61 @@ fn a_surface_meeting_an_interface_or_the_boundary_is_refused_naming_where() {
         e => panic!("{e}"),
     }
 }
+
+#[test]
+fn a_surface_touching_the_interface_at_one_point_is_refused_exactly() {
+    let (s, m) = nested();
+    // The inner ball's first vertex w (an icosahedron vertex, radius 1.5), and a lesion outside
+    // the inner ball whose vertex 3 (pointing at the origin) is put exactly on w: the two meet at
+    // that point only.
+    let w = s
+        .points
+        .iter()
+        .copied()
+        .find(|p| {
+            let r2 = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
+            (r2 - 2.25).abs() < 1e-9
+        })
+        .unwrap();
+    let r = 1.5;
+    let mut lesion = ball(
+        [
+            w[0] + 0.5 * w[0] / r,
+            w[1] + 0.5 * w[1] / r,
+            w[2] + 0.5 * w[2] / r,
+        ],
+        0.5,
+        1.0,
+    );
+    let k = (0..lesion.points.len())
+        .min_by(|&a, &b| {
+            let d = |p: [f64; 3]| (0..3).map(|i| (p[i] - w[i]).powi(2)).sum::<f64>();
+            d(lesion.points[a]).total_cmp(&d(lesion.points[b]))
+        })
+        .unwrap();
+    lesion.points[k] = w;
+    let e = run_insert(&m, &lesion, 3, 0.2).unwrap_err().to_string();
+    assert!(
+        e.contains("meets the interface between regions 1 and 2"),
+        "{e}"
+    );
+    // Moved off w by a hair towards the lesion's centre, it is accepted.
+    let c = [
+        w[0] + 0.5 * w[0] / r,
+        w[1] + 0.5 * w[1] / r,
+        w[2] + 0.5 * w[2] / r,
+    ];
+    lesion.points[k] = [0, 1, 2].map(|i| w[i] + 1e-6 * (c[i] - w[i]));
+    let (out, _) = run_insert(&m, &lesion, 3, 0.2).unwrap();
+    let c = check(&out, Some(&with_lesion(&s, &lesion, 3, 1)));
+    assert!(c.valid, "{:?}", c.problems);
+}
+
+#[test]
+fn shells_in_two_regions_are_refused() {
+    let (_, m) = nested();
+    let mut two = ball([2.7, 0.0, 0.0], 0.4, 1.0);
+    two.append(&ball([0.0, 0.0, 0.0], 0.5, 1.0));
+    let e = run_insert(&m, &two, 3, 0.2).unwrap_err().to_string();
+    assert!(e.contains("shells in regions 1 and 2"), "{e}");
+}
