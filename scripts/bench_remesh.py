@@ -221,8 +221,8 @@ def whole(exe, mesh):
             "lt10": q["n_dihedral_lt_10"]}
 
 
-def bench_mesh(exe, mmg, tmp, name, mesh_args, repeat, cost_zone):
-    """Every case on one base mesh; returns the rows."""
+def bench_mesh(exe, mmg, tmp, name, mesh_args, repeat, own_size):
+    """Every case on one base mesh (`own_size`: its --size, None for the default sizing); returns the rows."""
     base = os.path.join(tmp, f"{name}.vtu")
     start = time.perf_counter()
     j = json.loads(run([exe, "mesh", SURFACE, *mesh_args, "-o", base, "--json"]).stdout)
@@ -256,12 +256,11 @@ def bench_mesh(exe, mmg, tmp, name, mesh_args, repeat, cost_zone):
         ("10 mm ellipsoid lesion inside grey matter",
          ["--insert", lesion, "--label", "3", "--margin", f"{margin:.4g}"], None, lesion),
     ]
-    if cost_zone:
-        # The ball around the lesion's spot holding about 1% of the tets (by centroid).
-        r = float(np.sort(np.linalg.norm(p[t].mean(axis=1) - spot, axis=1))[len(t) // 100])
-        cases.append(("about 1% of the tets (ball), the mesh's own size",
-                      ["--sphere", ",".join(f"{x:.4g}" for x in spot) + f",{r:.4g}", "--size", f"{hg:.4g}"],
-                      None, None))
+    # The ball around the lesion's spot holding about 1% of the tets (by centroid), at the mesh's --size.
+    r = float(np.sort(np.linalg.norm(p[t].mean(axis=1) - spot, axis=1))[len(t) // 100])
+    cases.append(("about 1% of the tets (ball), the mesh's own size",
+                  ["--sphere", ",".join(f"{x:.4g}" for x in spot) + f",{r:.4g}", "--size", f"{own_size or hg:.4g}"],
+                  None, None))
     for label, args, hsiz, les in cases:
         out = os.path.join(tmp, f"{name}_out.vtu")
         secs, wall, j = biotet_remesh(exe, base, args, out, repeat)
@@ -315,6 +314,31 @@ def bench_mesh(exe, mmg, tmp, name, mesh_args, repeat, cost_zone):
     return rows
 
 
+def cost(exe, tmp, size, repeat):
+    """Meshing the whole model at --size `size` against refilling a ball holding about 1% of its tets at the same
+    size: medians of `repeat` runs each (library seconds: reading and writing aside)."""
+    base = os.path.join(tmp, "cost.vtu")
+    mesh_secs = []
+    for _ in range(repeat):
+        j = json.loads(run([exe, "mesh", SURFACE, "--size", str(size), "-o", base, "--json"]).stdout)
+        mesh_secs.append(j["pipeline"]["seconds_total"] + (j.get("seconds_sizing") or 0.0))
+    medit = os.path.join(tmp, "cost.mesh")
+    run([exe, "convert", base, "-o", medit, "--quiet"])
+    p, t, refs = read_medit(medit)
+    spot, _, _ = places(p, t, refs, 0.0)
+    r = float(np.sort(np.linalg.norm(p[t].mean(axis=1) - spot, axis=1))[len(t) // 100])
+    args = ["--sphere", ",".join(f"{x:.4g}" for x in spot) + f",{r:.4g}", "--size", str(size)]
+    secs, wall, j = biotet_remesh(exe, base, args, os.path.join(tmp, "cost_out.vtu"), repeat)
+    rem = j["remesh"]
+    row = {"case": "cost", "tets": len(t), "mesh_seconds": statistics.median(mesh_secs), "mesh_runs": mesh_secs,
+           "zone": " ".join(args), "removed": rem["tets_before"] - rem["tets_kept"],
+           "added": rem["tets_after"] - rem["tets_kept"], "remesh_seconds": secs, "remesh_wall": wall,
+           "seconds_select": rem["seconds_select"], "seconds_splice": rem["seconds_splice"]}
+    row["share"] = row["remesh_seconds"] / row["mesh_seconds"]
+    print(json.dumps(row))
+    return [row]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--biotet")
@@ -323,6 +347,8 @@ def main():
     ap.add_argument("--fine-repeat", type=int, default=1)
     ap.add_argument("--skip-fine", action="store_true")
     ap.add_argument("--skip-default", action="store_true")
+    ap.add_argument("--cost-only", action="store_true",
+                    help="only the 1%% zone against meshing the whole model at --fine-size, --repeat runs each")
     ap.add_argument("--no-mmg", action="store_true")
     ap.add_argument("--json")
     a = ap.parse_args()
@@ -333,9 +359,15 @@ def main():
         print("mmg3d not found (pip install pymmg); MMG skipped", file=sys.stderr)
     tmp = tempfile.mkdtemp(prefix="bench_remesh_")
     try:
-        rows = [] if a.skip_default else bench_mesh(exe, mmg, tmp, "default", [], a.repeat, True)
+        if a.cost_only:
+            rows = cost(exe, tmp, a.fine_size, a.repeat)
+            if a.json:
+                with open(a.json, "w") as f:
+                    json.dump(rows, f, indent=2)
+            return
+        rows = [] if a.skip_default else bench_mesh(exe, mmg, tmp, "default", [], a.repeat, None)
         if not a.skip_fine:
-            rows += bench_mesh(exe, mmg, tmp, "fine", ["--size", str(a.fine_size)], a.fine_repeat, True)
+            rows += bench_mesh(exe, mmg, tmp, "fine", ["--size", str(a.fine_size)], a.fine_repeat, a.fine_size)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     print(f"{'mesh':<8} {'case':<52} {'tool':<7} {'s':>8} {'removed':>8} {'added':>9} "

@@ -3,7 +3,7 @@
 
 use super::{CavityReport, RemeshError, RemeshReport};
 use crate::mesh::surface::SurfaceMesh;
-use crate::mesh::tet::{NO_NEIGHBOR, TET_FACES, TetMesh};
+use crate::mesh::tet::{NO_NEIGHBOR, TET_FACES, TetMesh, sorted3};
 use crate::mesh::validate::{SurfaceError, ValidateOptions, validate_surface};
 use crate::pipeline::{PipelineOptions, mesh_surface};
 use crate::sizing::{Sizing, SizingError};
@@ -149,6 +149,11 @@ fn cavity_surface(cavity: &Cavity, inner: Option<&Inner>) -> Result<SurfaceMesh,
     Ok(s)
 }
 
+/// The sorted corners of face `f` of `tet`.
+fn face_key(tet: &[u32; 4], f: usize) -> [u32; 3] {
+    sorted3(TET_FACES[f].map(|k| tet[k]))
+}
+
 /// Refill every cavity and splice the new tets in after the kept ones; unused points dropped.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn replace(
@@ -167,17 +172,37 @@ pub(super) fn replace(
     let mut points = mesh.points.clone();
     let mut tets: Vec<[u32; 4]> = Vec::with_capacity(nt);
     let mut labels: Vec<u32> = Vec::with_capacity(nt);
+    // Adjacency is carried over rather than rebuilt (a full rebuild is most of the cost of a
+    // small zone in a large mesh): kept tets keep theirs, renumbered; new tets take their
+    // cavity mesh's; the faces left open on either side (the shells) are paired by their corners.
+    let mut old_to_new = vec![u32::MAX; nt];
     for t in (0..nt).filter(|&t| !carved[t]) {
+        old_to_new[t] = tets.len() as u32;
         tets.push(mesh.tets[t]);
         labels.push(mesh.labels[t]);
     }
     let tets_kept = tets.len();
+    let mut neighbors: Vec<[u32; 4]> = Vec::with_capacity(nt);
+    let mut open: Vec<([u32; 3], u32)> = Vec::new();
+    for (i, t) in (0..nt).filter(|&t| !carved[t]).enumerate() {
+        let mut nb = mesh.neighbors[t];
+        for (f, n) in nb.iter_mut().enumerate() {
+            if *n == NO_NEIGHBOR {
+                continue;
+            }
+            *n = old_to_new[*n as usize];
+            if *n == NO_NEIGHBOR {
+                open.push((face_key(&tets[i], f), (4 * i + f) as u32));
+            }
+        }
+        neighbors.push(nb);
+    }
     let mut reports = Vec::new();
     for cavity in &cavities {
         let region = cavity.region;
         let surface = cavity_surface(cavity, inner)?;
         let sz = sizing(&surface).map_err(|source| RemeshError::Sizing { region, source })?;
-        let (sub, report) = mesh_surface(&surface, sz, opts, &mut |s| {
+        let (mut sub, report) = mesh_surface(&surface, sz, opts, &mut |s| {
             progress(&format!("region {region}: {s}"))
         })
         .map_err(|source| RemeshError::Pipeline { region, source })?;
@@ -204,9 +229,23 @@ pub(super) fn replace(
             }
         };
         let inserted = inner.map_or(region, |i| i.label);
-        for (t, &l) in sub.tets.iter().zip(&sub.labels) {
+        if sub.neighbors.len() != sub.tets.len() {
+            sub.rebuild_neighbors();
+        }
+        let first_tet = tets.len() as u32;
+        for ((t, &l), nb) in sub.tets.iter().zip(&sub.labels).zip(&sub.neighbors) {
+            let i = tets.len();
             tets.push(t.map(to_mesh));
             labels.push(if l == INSERTED { inserted } else { region });
+            let mut nb = *nb;
+            for (f, n) in nb.iter_mut().enumerate() {
+                if *n == NO_NEIGHBOR {
+                    open.push((face_key(&tets[i], f), (4 * i + f) as u32));
+                } else {
+                    *n += first_tet;
+                }
+            }
+            neighbors.push(nb);
         }
         reports.push(CavityReport {
             region,
@@ -238,7 +277,22 @@ pub(super) fn replace(
     for t in &mut tets {
         *t = t.map(|v| renumber[v as usize]);
     }
-    let out = TetMesh::new(kept_points, tets, labels);
+    // A shell face is open on both sides (kept and new, or two cavities across an interface);
+    // a face open once is on the boundary.
+    open.sort_unstable();
+    for w in open.windows(2) {
+        if w[0].0 == w[1].0 {
+            let (a, b) = (w[0].1 as usize, w[1].1 as usize);
+            neighbors[a / 4][a % 4] = (b / 4) as u32;
+            neighbors[b / 4][b % 4] = (a / 4) as u32;
+        }
+    }
+    let out = TetMesh {
+        points: kept_points,
+        tets,
+        neighbors,
+        labels,
+    };
     let report = RemeshReport {
         tets_before: nt,
         tets_after: out.tets.len(),

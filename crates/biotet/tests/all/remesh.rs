@@ -46,6 +46,16 @@ fn tet_set(m: &TetMesh, range: std::ops::Range<usize>) -> BTreeSet<([[u64; 3]; 4
         .collect()
 }
 
+/// The adjacency carried over by the splice is the one a full rebuild finds.
+fn assert_adjacency(m: &TetMesh) {
+    let mut rebuilt = m.clone();
+    rebuilt.rebuild_neighbors();
+    assert!(
+        rebuilt.neighbors == m.neighbors,
+        "adjacency differs from a rebuild"
+    );
+}
+
 fn region_volumes(m: &TetMesh) -> Vec<(u32, f64)> {
     QualityReport::of(m)
         .regions
@@ -70,6 +80,7 @@ fn assert_in_place(
 ) {
     let c = check(after, Some(s));
     assert!(c.valid, "{:?}", c.problems);
+    assert_adjacency(after);
     assert_eq!(after.tets.len() - kept, changed);
     let old = tet_set(before, 0..before.tets.len());
     let kept_set = tet_set(after, 0..kept);
@@ -214,6 +225,7 @@ fn inserting_a_surface_inside_one_region_keeps_the_rest() {
         // Valid against the model's surface plus the lesion between labels 3 and `around`.
         let c = check(&out, Some(&with_lesion(&s, &lesion, 3, around)));
         assert!(c.valid, "{:?}", c.problems);
+        assert_adjacency(&out);
         // Region 3 holds exactly the lesion's volume, taken from the region around it.
         let v3 = volume_of(&out, 3);
         let mut lesion_mesh = lesion.clone();
