@@ -236,7 +236,8 @@ def bench_mesh(exe, mmg, tmp, name, mesh_args, repeat, own_size):
     hg = region_edge(p, t, refs, 1)
     print(f"{name}: {len(t)} tets, meshed in {mesh_secs:.2f} s; median edge: white {h:.3f}, grey {hg:.3f}",
           file=sys.stderr)
-    rows = [{"mesh": name, "case": "whole model (biotet mesh)", "tets": len(t), "seconds": mesh_secs}]
+    rows = [{"mesh": name, "case": "whole model (biotet mesh)", "tets": len(t), "seconds": mesh_secs,
+             "whole": whole(exe, base)}]
     axes = (5.0, 3.5, 3.0)
     spot, clear, across = places(p, t, refs, max(axes))
     lesion = os.path.join(tmp, f"{name}_lesion.off")

@@ -10,11 +10,38 @@ type P3 = [f64; 3];
 /// Does the tet with corners `c` meet the zone? Floating point: the zone is the user's choice
 /// of what to replace, not a combinatorial decision of the mesh.
 pub(super) fn meets(zone: &Zone, label: u32, c: &[P3; 4]) -> bool {
+    // The tet's box first: most tets of a large mesh are far from a small zone.
+    let (tlo, thi) = bounds(c);
     match *zone {
         Zone::Region(r) => label == r,
-        Zone::Box { lo, hi } => tet_meets_box(c, lo, hi),
-        Zone::Sphere { centre, radius } => tet_distance(c, centre) <= radius,
+        Zone::Box { lo, hi } => {
+            (0..3).all(|k| tlo[k] <= hi[k] && thi[k] >= lo[k]) && tet_meets_box(c, lo, hi)
+        }
+        Zone::Sphere { centre, radius } => {
+            let gap: f64 = (0..3)
+                .map(|k| {
+                    (tlo[k] - centre[k])
+                        .max(centre[k] - thi[k])
+                        .max(0.0)
+                        .powi(2)
+                })
+                .sum();
+            gap <= radius * radius && tet_distance(c, centre) <= radius
+        }
     }
+}
+
+/// The box of a tet's corners.
+fn bounds(c: &[P3; 4]) -> (P3, P3) {
+    let mut lo = c[0];
+    let mut hi = c[0];
+    for p in &c[1..] {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    (lo, hi)
 }
 
 /// Separating-axis test of a tet and an axis-aligned box (both closed).
