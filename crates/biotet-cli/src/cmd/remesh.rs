@@ -19,10 +19,11 @@ Examples:
   biotet remesh head.vtu --region 2 --size 1.5 -o head_fine_wm.vtu
   biotet remesh head.vtu --sphere 10,-20,35,10 --size 0.8 -o head_electrode.vtu
   biotet remesh head.vtu --box 0,0,0,20,20,20 --size 3 -o head_coarse.vtu --json
-  biotet remesh head.vtu --insert lesion.stl --label 5 --size 0.8 --margin 2 -o head_lesion.vtu
+  biotet remesh head.vtu --insert lesion.stl --label 5 --margin 2 -o head_lesion.vtu
 
 --insert embeds a closed surface lying inside one region: the tets meeting it and those within
---margin of it are refilled, its inside labelled L. A surface that meets or crosses an
+--margin of it are refilled, its inside labelled L. Without --size the sizes come from the
+surface's and the cavity shell's edges, which suits a surface finer than the mesh. A surface that meets or crosses an
 interface or the outer boundary (or encloses part of one) is refused, naming the triangle, the
 interface and the point; crossing an interface is not handled yet.";
 
