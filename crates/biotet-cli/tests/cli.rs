@@ -1610,3 +1610,105 @@ fn remesh_replaces_a_zone_keeps_the_rest_and_refuses_a_missing_zone() {
         assert!(!none.exists());
     }
 }
+
+/// An ellipsoid (icosphere of two levels, radii `r`) centred at `c`, as OFF text.
+fn ellipsoid_off(c: [f64; 3], r: [f64; 3]) -> String {
+    let e = biotet::SurfaceMesh::icosphere(1.0, 2);
+    let mut text = format!("OFF\n{} {} 0\n", e.points.len(), e.triangles.len());
+    for p in &e.points {
+        text += &format!(
+            "{} {} {}\n",
+            c[0] + r[0] * p[0],
+            c[1] + r[1] * p[1],
+            c[2] + r[2] * p[2]
+        );
+    }
+    for t in &e.triangles {
+        text += &format!("3 {} {} {}\n", t[0], t[1], t[2]);
+    }
+    text
+}
+
+#[test]
+fn remesh_insert_embeds_a_surface_and_refuses_one_crossing_the_boundary() {
+    let dir = tempfile::tempdir().unwrap();
+    let surface = root().join("tests/data/shapes/tm_icosphere.off");
+    let base = dir.path().join("base.vtu");
+    let out = biotet(&["mesh", s(&surface), "-o", s(&base), "--quiet"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let lesion = dir.path().join("lesion.off");
+    std::fs::write(&lesion, ellipsoid_off([0.2, 0.1, 0.0], [0.35, 0.2, 0.25])).unwrap();
+    let new = dir.path().join("new.vtu");
+    let out = biotet(&[
+        "remesh",
+        s(&base),
+        "--insert",
+        s(&lesion),
+        "--label",
+        "5",
+        "--size",
+        "0.08",
+        "-o",
+        s(&new),
+        "--json",
+    ]);
+    let j = json_of(&out);
+    let r = &j["remesh"];
+    assert!(r["tets_kept"].as_u64().unwrap() > 0, "{r}");
+    let labels: Vec<u64> = j["quality"]["regions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x["label"].as_u64().unwrap())
+        .collect();
+    assert_eq!(labels, [1, 5]);
+    // Valid against the sphere and the lesion as a region 5 inside region 1.
+    let lesion_name = lesion.file_name().unwrap().to_str().unwrap();
+    let check = biotet(&[
+        "check",
+        s(&new),
+        "-s",
+        s(&surface),
+        "-s",
+        s(&lesion),
+        "--label",
+        "tm_icosphere.off=1",
+        "--label",
+        &format!("{lesion_name}=5"),
+    ]);
+    assert!(check.status.success(), "{}", stderr(&check));
+
+    // Across the outer boundary: refused on one line naming the triangle, the boundary and a
+    // point; nothing written.
+    let crossing = dir.path().join("crossing.off");
+    std::fs::write(&crossing, ellipsoid_off([0.9, 0.0, 0.0], [0.3, 0.2, 0.2])).unwrap();
+    let none = dir.path().join("none.vtu");
+    let out = biotet(&[
+        "remesh",
+        s(&base),
+        "--insert",
+        s(&crossing),
+        "--label",
+        "5",
+        "-o",
+        s(&none),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let e = stderr(&out);
+    assert_eq!(e.trim_end().lines().count(), 1, "{e}");
+    for part in [
+        "error: ",
+        "cannot insert",
+        "triangle ",
+        "outer boundary of region 1",
+        "near (",
+    ] {
+        assert!(e.contains(part), "{part}: {e}");
+    }
+    assert!(!none.exists());
+    // --label without --insert, and --insert without --label, are usage errors.
+    let out = biotet(&["remesh", s(&base), "--insert", s(&lesion), "-o", s(&none)]);
+    assert!(!out.status.success() && !none.exists());
+    let help = biotet(&["remesh", "--help"]);
+    assert!(String::from_utf8_lossy(&help.stdout).contains("--insert lesion.stl --label"));
+}

@@ -1,5 +1,6 @@
-//! `biotet remesh`: replace one region, or the tets meeting a box or a sphere, at a new size;
-//! every other tet stays exactly as it was (see `biotet::remesh`).
+//! `biotet remesh`: replace one region, or the tets meeting a box or a sphere, at a new size, or
+//! embed a closed surface as a new region; every other tet stays exactly as it was (see
+//! `biotet::remesh`).
 
 use super::input::numbers;
 use crate::{Common, progress::Stage};
@@ -7,7 +8,7 @@ use anyhow::{Context, Result, bail};
 use biotet::TetMesh;
 use biotet::pipeline::PipelineOptions;
 use biotet::quality::QualityReport;
-use biotet::remesh::{Zone, remesh};
+use biotet::remesh::{RemeshReport, Zone, insert, remesh};
 use biotet::sizing::{SizeSpec, Sizing, SizingOptions};
 use serde_json::json;
 use std::path::PathBuf;
@@ -18,7 +19,14 @@ const EXAMPLES: &str = "\
 Examples:
   biotet remesh head.vtu --region 2 --size 1.5 -o head_fine_wm.vtu
   biotet remesh head.vtu --sphere 10,-20,35,10 --size 0.8 -o head_electrode.vtu
-  biotet remesh head.vtu --box 0,0,0,20,20,20 --size 3 -o head_coarse.vtu --json";
+  biotet remesh head.vtu --box 0,0,0,20,20,20 --size 3 -o head_coarse.vtu --json
+  biotet remesh head.vtu --insert lesion.stl --label 5 --margin 2 -o head_lesion.vtu
+
+--insert embeds a closed surface lying inside one region: the tets meeting it and those within
+--margin of it are refilled, its inside labelled L. Without --size the sizes come from the
+surface's and the cavity shell's edges, which suits a surface finer than the mesh. A surface that meets or crosses an
+interface or the outer boundary (or encloses part of one) is refused, naming the triangle, the
+interface and the point; crossing an interface is not handled yet.";
 
 /// Arguments of `biotet remesh`.
 #[derive(clap::Args)]
@@ -30,20 +38,35 @@ pub struct Args {
     #[arg(short, long, value_name = "OUT")]
     output: PathBuf,
     /// Replace every tet of this region.
-    #[arg(long, value_name = "L", conflicts_with_all = ["box_zone", "sphere"])]
+    #[arg(long, value_name = "L", conflicts_with_all = ["box_zone", "sphere", "insert"])]
     region: Option<u32>,
     /// Replace every tet meeting the box X0,Y0,Z0,X1,Y1,Z1 (each region refilled with its own
     /// label).
     #[arg(
         long = "box",
         value_name = "X0,Y0,Z0,X1,Y1,Z1",
-        conflicts_with = "sphere",
+        conflicts_with_all = ["sphere", "insert"],
         allow_hyphen_values = true
     )]
     box_zone: Option<String>,
     /// Replace every tet meeting the ball X,Y,Z,R.
-    #[arg(long, value_name = "X,Y,Z,R", allow_hyphen_values = true)]
+    #[arg(
+        long,
+        value_name = "X,Y,Z,R",
+        allow_hyphen_values = true,
+        conflicts_with = "insert"
+    )]
     sphere: Option<String>,
+    /// Embed this closed surface (inside one region) as a new region labelled --label.
+    #[arg(long, value_name = "SURFACE", requires = "label")]
+    insert: Option<PathBuf>,
+    /// The label of the inside of the --insert surface.
+    #[arg(long, value_name = "L", requires = "insert")]
+    label: Option<u32>,
+    /// With --insert: also replace the tets with a corner within this distance of the surface
+    /// (default: --size, or the surface's mean edge length).
+    #[arg(long, value_name = "M", requires = "insert")]
+    margin: Option<f64>,
     /// Uniform size of the new tets. Without it, sizes come from the cavity's shell (its edges,
     /// growing inward by --grading).
     #[arg(long, value_name = "H")]
@@ -77,17 +100,41 @@ fn zone(a: &Args) -> Result<Zone> {
             radius: v[3],
         });
     }
-    bail!("give the zone to remesh: --region L, --box X0,Y0,Z0,X1,Y1,Z1 or --sphere X,Y,Z,R")
+    bail!(
+        "give the zone to remesh: --region L, --box X0,Y0,Z0,X1,Y1,Z1, --sphere X,Y,Z,R or \
+         --insert SURFACE --label L"
+    )
+}
+
+/// The mean edge length of a surface (0 for none).
+fn mean_edge(s: &biotet::SurfaceMesh) -> f64 {
+    let mut sum = 0.0;
+    for t in 0..s.triangles.len() {
+        let c = s.corners(t);
+        for k in 0..3 {
+            sum += biotet::geom::vec3::norm(biotet::geom::vec3::sub(c[(k + 1) % 3], c[k]));
+        }
+    }
+    sum / (3 * s.triangles.len()).max(1) as f64
 }
 
 /// Run `biotet remesh`.
 pub fn run(a: Args) -> Result<ExitCode> {
-    let zone = zone(&a)?;
     if let Some(h) = a.size
         && !(h > 0.0 && h.is_finite())
     {
         bail!("--size {h}: expected a positive number");
     }
+    if let Some(m) = a.margin
+        && !(m >= 0.0 && m.is_finite())
+    {
+        bail!("--margin {m}: expected a number at least 0");
+    }
+    // The zone's arguments are checked before anything is read.
+    let zone = match a.insert {
+        Some(_) => Zone::Region(0),
+        None => zone(&a)?,
+    };
     let stage = Stage::start(a.common.quiet, format!("reading {}", a.mesh.display()));
     let mesh = super::input::tet_mesh(&a.mesh, a.common)?;
     let name = a.mesh.display().to_string();
@@ -96,14 +143,36 @@ pub fn run(a: Args) -> Result<ExitCode> {
         None => SizeSpec::FromSurface { grading: a.grading },
     };
     let sizing = |s: &biotet::SurfaceMesh| Sizing::new(s, SizingOptions::new(spec()));
-    let (out, report) = remesh(
-        &mesh,
-        &zone,
-        &sizing,
-        &PipelineOptions::default(),
-        &mut |s| stage.set(s.to_string()),
-    )
-    .with_context(|| format!("{name}: cannot remesh"))?;
+    let opts = PipelineOptions::default();
+    let mut progress = |s: &str| stage.set(s.to_string());
+    let (out, report, what): (TetMesh, RemeshReport, _) = match &a.insert {
+        None => {
+            let (out, report) = remesh(&mesh, &zone, &sizing, &opts, &mut progress)
+                .with_context(|| format!("{name}: cannot remesh"))?;
+            (out, report, json!(format!("{zone:?}")))
+        }
+        Some(path) => {
+            stage.set(format!("reading {}", path.display()));
+            let surface = biotet_io::read_surface(path)?.mesh;
+            let label = a.label.unwrap_or(0);
+            let margin = a.margin.unwrap_or(match a.size {
+                Some(h) => h,
+                None => mean_edge(&surface),
+            });
+            let (out, report) = insert(
+                &mesh,
+                &surface,
+                label,
+                margin,
+                &sizing,
+                &opts,
+                &mut progress,
+            )
+            .with_context(|| format!("{name}: cannot insert {}", path.display()))?;
+            let what = json!({ "insert": path, "label": label, "margin": margin });
+            (out, report, what)
+        }
+    };
     stage.set("measuring");
     let new_tets = TetMesh {
         points: out.points.clone(),
@@ -121,7 +190,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
             "input": name,
             "output": a.output,
             "written": written,
-            "zone": format!("{zone:?}"),
+            "zone": what,
             "remesh": report,
             "quality_new": q_new,
             "quality": q_all,
@@ -145,6 +214,13 @@ pub fn run(a: Args) -> Result<ExitCode> {
                 c.points_added,
                 c.pipeline.seconds_total
             );
+        }
+        if let Some(l) = a.label.filter(|_| a.insert.is_some()) {
+            let inside = out.labels[report.tets_kept..]
+                .iter()
+                .filter(|&&x| x == l)
+                .count();
+            text += &format!("  inside the inserted surface: {inside} tets labelled {l}\n");
         }
         text += &format!(
             "new tets: min dihedral {:.3}°, max {:.3}°, below 10°: {}\nwhole mesh: min dihedral {:.3}°, max {:.3}°, below 10°: {}",

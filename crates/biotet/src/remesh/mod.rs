@@ -11,21 +11,21 @@
 //! coordinates bit for bit and its label. The cost is that of meshing the cavity, plus one pass
 //! over the mesh to select, splice and rebuild adjacency.
 
-use crate::geom::vec3::{cross, dot, norm, sub};
+mod cavity;
+mod insert;
+mod zone;
+
+pub use insert::insert;
+
 use crate::mesh::surface::SurfaceMesh;
-use crate::mesh::tet::{NO_NEIGHBOR, TET_FACES, TetMesh};
-use crate::mesh::validate::{SurfaceError, ValidateOptions, validate_surface};
-use crate::pipeline::{MeshReport, PipelineError, PipelineOptions, mesh_surface};
+use crate::mesh::tet::TetMesh;
+use crate::mesh::validate::SurfaceError;
+use crate::pipeline::{MeshReport, PipelineError, PipelineOptions};
 use crate::sizing::{Sizing, SizingError};
-use crate::surface::bvh::closest_on_triangle;
-use rustc_hash::FxHashMap;
 use serde::Serialize;
 use std::time::Instant;
 
 type P3 = [f64; 3];
-
-/// Rounds of carving the tets around a pinched edge or vertex of a cavity's shell.
-const MAX_GROW: usize = 32;
 
 /// Which tets to replace.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -81,6 +81,60 @@ pub enum RemeshError {
         #[source]
         source: SurfaceError,
     },
+    /// The surface to insert is not a valid closed surface.
+    #[error("the surface to insert is not a valid closed surface")]
+    Surface(#[source] SurfaceError),
+    /// The surface to insert meets the mesh's outer boundary or an interface between regions.
+    #[error(
+        "triangle {triangle} of the inserted surface {how} {what} (mesh face {face:?}) near ({}, {}, {}); \
+         only a surface inside one region is inserted",
+        point[0], point[1], point[2]
+    )]
+    Crossing {
+        /// The triangle of the inserted surface.
+        triangle: usize,
+        /// "crosses" or "touches".
+        how: &'static str,
+        /// "the interface between regions A and B" or "the outer boundary of region A".
+        what: String,
+        /// The mesh face (point indices of the input mesh).
+        face: [u32; 3],
+        /// A point of the intersection (rounded; the decision is exact).
+        point: P3,
+    },
+    /// The surface to insert lies outside the mesh.
+    #[error("the inserted surface lies outside the mesh (its point {point} at {at:?})")]
+    Outside {
+        /// A point of the surface.
+        point: usize,
+        /// Its coordinates.
+        at: P3,
+    },
+    /// The surface to insert encloses part of the outer boundary or of an interface.
+    #[error(
+        "the inserted surface encloses part of {what} (mesh point {point} at {at:?}); only a surface inside one region is inserted"
+    )]
+    Encloses {
+        /// "the interface between regions A and B" or "the outer boundary of region A".
+        what: String,
+        /// The mesh point inside the surface.
+        point: u32,
+        /// Its coordinates.
+        at: P3,
+    },
+    /// The label to give the inside cannot be used.
+    #[error("label {label}: {reason}")]
+    Label {
+        /// The label.
+        label: u32,
+        /// Why.
+        reason: &'static str,
+    },
+    /// The inserted surface's shells lie in different regions.
+    #[error(
+        "the inserted surface has shells in regions {0} and {1}: insert one region's at a time"
+    )]
+    Regions(u32, u32),
     /// Recovery left shell triangles out of a cavity's mesh.
     #[error(
         "region {region}: {missing} triangles of the cavity's shell could not be recovered; first: {first}"
@@ -139,102 +193,6 @@ pub struct RemeshReport {
     pub seconds_total: f64,
 }
 
-/// Does the tet with corners `c` meet the zone? Floating point: the zone is the user's choice
-/// of what to replace, not a combinatorial decision of the mesh.
-fn meets(zone: &Zone, label: u32, c: &[P3; 4]) -> bool {
-    match *zone {
-        Zone::Region(r) => label == r,
-        Zone::Box { lo, hi } => tet_meets_box(c, lo, hi),
-        Zone::Sphere { centre, radius } => tet_distance(c, centre) <= radius,
-    }
-}
-
-/// Separating-axis test of a tet and an axis-aligned box (both closed).
-fn tet_meets_box(c: &[P3; 4], lo: P3, hi: P3) -> bool {
-    let box_corners: Vec<P3> = (0..8)
-        .map(|i| {
-            [
-                if i & 1 == 0 { lo[0] } else { hi[0] },
-                if i & 2 == 0 { lo[1] } else { hi[1] },
-                if i & 4 == 0 { lo[2] } else { hi[2] },
-            ]
-        })
-        .collect();
-    let separated = |axis: P3| {
-        if dot(axis, axis) == 0.0 {
-            return false;
-        }
-        let (a0, a1) = c
-            .iter()
-            .map(|p| dot(*p, axis))
-            .fold((f64::MAX, f64::MIN), |(l, h), x| (l.min(x), h.max(x)));
-        let (b0, b1) = box_corners
-            .iter()
-            .map(|p| dot(*p, axis))
-            .fold((f64::MAX, f64::MIN), |(l, h), x| (l.min(x), h.max(x)));
-        a1 < b0 || b1 < a0
-    };
-    let axes_box = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-    if axes_box.iter().any(|&a| separated(a)) {
-        return false;
-    }
-    for f in TET_FACES {
-        if separated(cross(sub(c[f[1]], c[f[0]]), sub(c[f[2]], c[f[0]]))) {
-            return false;
-        }
-    }
-    for (i, j) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
-        let e = sub(c[j], c[i]);
-        if axes_box.iter().any(|&a| separated(cross(e, a))) {
-            return false;
-        }
-    }
-    true
-}
-
-/// Distance from `p` to the closed tet `c` (0 inside).
-fn tet_distance(c: &[P3; 4], p: P3) -> f64 {
-    let inside = TET_FACES.iter().all(|f| {
-        let n = cross(sub(c[f[1]], c[f[0]]), sub(c[f[2]], c[f[0]]));
-        dot(n, sub(p, c[f[0]])) <= 0.0
-    });
-    if inside {
-        return 0.0;
-    }
-    TET_FACES
-        .iter()
-        .map(|f| norm(sub(p, closest_on_triangle(p, &[c[f[0]], c[f[1]], c[f[2]]]))))
-        .fold(f64::INFINITY, f64::min)
-}
-
-/// The shell of the carved tets `tets` (all of region `label`): its faces towards tets not
-/// carved or of another region, or on the boundary, outward from the cavity, as a closed surface of region `label`
-/// with local point numbering; and the local-to-mesh point map.
-fn shell(mesh: &TetMesh, carved: &[bool], tets: &[u32], label: u32) -> (SurfaceMesh, Vec<u32>) {
-    let mut local: FxHashMap<u32, u32> = FxHashMap::default();
-    let mut global: Vec<u32> = Vec::new();
-    let mut triangles = Vec::new();
-    for &t in tets {
-        for (i, f) in TET_FACES.iter().enumerate() {
-            let n = mesh.neighbors[t as usize][i];
-            // A carved neighbour of another region is across an interface: the face belongs
-            // to both cavities' shells, recovered in each, so the two refills meet on it.
-            if n != NO_NEIGHBOR && carved[n as usize] && mesh.labels[n as usize] == label {
-                continue;
-            }
-            let v = f.map(|k| mesh.tets[t as usize][k]);
-            triangles.push(v.map(|x| {
-                *local.entry(x).or_insert_with(|| {
-                    global.push(x);
-                    global.len() as u32 - 1
-                })
-            }));
-        }
-    }
-    let points = global.iter().map(|&g| mesh.points[g as usize]).collect();
-    (SurfaceMesh::closed(points, triangles, label), global)
-}
-
 /// Replace the tets of `zone` (see the module docs). `sizing` builds the size function on each
 /// cavity's shell; `opts` are the pipeline's options for the refill; `progress` hears
 /// `"region L: stage"`.
@@ -246,157 +204,14 @@ pub fn remesh(
     progress: &mut dyn FnMut(&str),
 ) -> Result<(TetMesh, RemeshReport), RemeshError> {
     let start = Instant::now();
-    let nt = mesh.tets.len();
-    let mut carved: Vec<bool> = (0..nt)
-        .map(|t| meets(zone, mesh.labels[t], &mesh.corners(t)))
+    let mut carved: Vec<bool> = (0..mesh.tets.len())
+        .map(|t| zone::meets(zone, mesh.labels[t], &mesh.corners(t)))
         .collect();
     if !carved.contains(&true) {
         return Err(RemeshError::Empty(format!("{zone:?}")));
     }
-    let mut grown = 0;
-    let shells = loop {
-        // Carved tets by region, in label order (deterministic), and their shells.
-        let mut by_region: std::collections::BTreeMap<u32, Vec<u32>> = Default::default();
-        for t in (0..nt).filter(|&t| carved[t]) {
-            by_region.entry(mesh.labels[t]).or_default().push(t as u32);
-        }
-        let mut shells = Vec::new();
-        let mut pinched: Vec<(u32, u32)> = Vec::new();
-        for (r, tets) in by_region {
-            let (mut s, map) = shell(mesh, &carved, &tets, r);
-            match validate_surface(&mut s, &ValidateOptions::default()) {
-                Ok(_) => shells.push((r, tets, s, map)),
-                // The carved tets touch themselves at an edge or a vertex: carve the tets of
-                // the region around it too, until the shell is a manifold surface.
-                Err(
-                    e @ (SurfaceError::NonManifoldEdge { .. }
-                    | SurfaceError::NonManifoldVertex { .. }),
-                ) if grown < MAX_GROW => {
-                    for t in e.triangles() {
-                        for v in s.triangles[t as usize] {
-                            pinched.push((r, map[v as usize]));
-                        }
-                    }
-                }
-                Err(source) => return Err(RemeshError::Shell { region: r, source }),
-            }
-        }
-        if pinched.is_empty() {
-            break shells;
-        }
-        grown += 1;
-        pinched.sort_unstable();
-        pinched.dedup();
-        for ((c, tet), &l) in carved.iter_mut().zip(&mesh.tets).zip(&mesh.labels) {
-            if !*c && tet.iter().any(|v| pinched.binary_search(&(l, *v)).is_ok()) {
-                *c = true;
-            }
-        }
-    };
-    let seconds_select = start.elapsed().as_secs_f64();
-
-    let mut points = mesh.points.clone();
-    let mut tets: Vec<[u32; 4]> = Vec::with_capacity(nt);
-    let mut labels: Vec<u32> = Vec::with_capacity(nt);
-    for t in (0..nt).filter(|&t| !carved[t]) {
-        tets.push(mesh.tets[t]);
-        labels.push(mesh.labels[t]);
-    }
-    let tets_kept = tets.len();
-    let mut cavities = Vec::new();
-    for (region, carved_tets, surface, map) in shells {
-        let sz = sizing(&surface).map_err(|source| RemeshError::Sizing { region, source })?;
-        let (sub, report) = mesh_surface(&surface, sz, opts, &mut |s| {
-            progress(&format!("region {region}: {s}"))
-        })
-        .map_err(|source| RemeshError::Pipeline { region, source })?;
-        if report.missing_triangles > 0 {
-            let first = report
-                .recover
-                .as_ref()
-                .and_then(|r| r.unrecovered.first())
-                .map_or(String::new(), |u| format!("{:?}: {}", u.corners, u.reason));
-            return Err(RemeshError::Unrecovered {
-                region,
-                missing: report.missing_triangles,
-                first,
-            });
-        }
-        let n_shell = surface.points.len();
-        let first_new = points.len() as u32;
-        points.extend_from_slice(&sub.points[n_shell..]);
-        let to_mesh = |x: u32| {
-            if (x as usize) < n_shell {
-                map[x as usize]
-            } else {
-                first_new + (x - n_shell as u32)
-            }
-        };
-        for (t, &l) in sub.tets.iter().zip(&sub.labels) {
-            tets.push(t.map(to_mesh));
-            labels.push(l);
-        }
-        cavities.push(CavityReport {
-            region,
-            tets_removed: carved_tets.len(),
-            tets_added: sub.tets.len(),
-            shell_triangles: surface.triangles.len(),
-            points_added: sub.points.len() - n_shell,
-            pipeline: report,
-        });
-    }
-
-    // Drop the points no tet uses any more (the old cavities' interiors), keeping the order.
-    let clock = Instant::now();
-    let mut used = vec![false; points.len()];
-    for t in &tets {
-        for &v in t {
-            used[v as usize] = true;
-        }
-    }
-    let mut renumber = vec![u32::MAX; points.len()];
-    let mut kept_points = Vec::with_capacity(points.len());
-    for (i, p) in points.iter().enumerate() {
-        if used[i] {
-            renumber[i] = kept_points.len() as u32;
-            kept_points.push(*p);
-        }
-    }
-    let points_dropped = points.len() - kept_points.len();
-    for t in &mut tets {
-        *t = t.map(|v| renumber[v as usize]);
-    }
-    let out = TetMesh::new(kept_points, tets, labels);
-    let report = RemeshReport {
-        tets_before: nt,
-        tets_after: out.tets.len(),
-        tets_kept,
-        points_before: mesh.points.len(),
-        points_after: out.points.len(),
-        points_dropped,
-        cavities,
-        grown,
-        seconds_select,
-        seconds_splice: clock.elapsed().as_secs_f64(),
-        seconds_total: start.elapsed().as_secs_f64(),
-    };
-    Ok((out, report))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn box_and_sphere_tests_agree_with_simple_cases() {
-        let c = [[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-        assert!(tet_meets_box(&c, [0.2; 3], [0.3; 3]));
-        assert!(!tet_meets_box(&c, [0.4; 3], [0.5; 3])); // beyond the slanted face
-        assert!(tet_meets_box(&c, [-1.0; 3], [0.0; 3])); // touching at a corner
-        assert!(!tet_meets_box(&c, [1.1, -1.0, -1.0], [2.0, 1.0, 1.0]));
-        assert_eq!(tet_distance(&c, [0.1; 3]), 0.0);
-        assert!((tet_distance(&c, [-1.0, 0.0, 0.0]) - 1.0).abs() < 1e-15);
-        let d = tet_distance(&c, [1.0; 3]);
-        assert!((d - (2.0 / 3f64.sqrt())).abs() < 1e-12, "{d}");
-    }
+    let (cavities, grown) = cavity::cavities(mesh, &mut carved)?;
+    cavity::replace(
+        mesh, &carved, cavities, None, sizing, opts, progress, start, grown,
+    )
 }

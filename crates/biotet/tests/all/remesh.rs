@@ -46,6 +46,16 @@ fn tet_set(m: &TetMesh, range: std::ops::Range<usize>) -> BTreeSet<([[u64; 3]; 4
         .collect()
 }
 
+/// The adjacency carried over by the splice is the one a full rebuild finds.
+fn assert_adjacency(m: &TetMesh) {
+    let mut rebuilt = m.clone();
+    rebuilt.rebuild_neighbors();
+    assert!(
+        rebuilt.neighbors == m.neighbors,
+        "adjacency differs from a rebuild"
+    );
+}
+
 fn region_volumes(m: &TetMesh) -> Vec<(u32, f64)> {
     QualityReport::of(m)
         .regions
@@ -70,6 +80,7 @@ fn assert_in_place(
 ) {
     let c = check(after, Some(s));
     assert!(c.valid, "{:?}", c.problems);
+    assert_adjacency(after);
     assert_eq!(after.tets.len() - kept, changed);
     let old = tet_set(before, 0..before.tets.len());
     let kept_set = tet_set(after, 0..kept);
@@ -149,4 +160,220 @@ fn a_zone_with_no_tet_is_refused() {
     )
     .unwrap_err();
     assert!(e.to_string().contains("no tet"), "{e}");
+}
+
+/// An icosphere of radius `r` (3 levels) centred at `c`, scaled by `stretch` along x.
+fn ball(c: [f64; 3], r: f64, stretch: f64) -> SurfaceMesh {
+    let mut s = SurfaceMesh::icosphere(r, 3);
+    for p in &mut s.points {
+        *p = [c[0] + stretch * p[0], c[1] + p[1], c[2] + p[2]];
+    }
+    s
+}
+
+fn run_insert(
+    m: &TetMesh,
+    lesion: &SurfaceMesh,
+    label: u32,
+    margin: f64,
+) -> Result<(TetMesh, biotet::remesh::RemeshReport), biotet::remesh::RemeshError> {
+    let sizing = |s: &SurfaceMesh| Sizing::new(s, SizingOptions::new(SizeSpec::Uniform(0.3)));
+    biotet::remesh::insert(
+        m,
+        lesion,
+        label,
+        margin,
+        &sizing,
+        &PipelineOptions::default(),
+        &mut |_| {},
+    )
+}
+
+/// The model's surface with the lesion added as the boundary between `label` and `around`.
+fn with_lesion(s: &SurfaceMesh, lesion: &SurfaceMesh, label: u32, around: u32) -> SurfaceMesh {
+    let mut all = s.clone();
+    let mut l = lesion.clone();
+    l.sides = vec![[label, around]; l.triangles.len()];
+    all.append(&l);
+    all
+}
+
+fn volume_of(m: &TetMesh, label: u32) -> f64 {
+    region_volumes(m)
+        .into_iter()
+        .find(|r| r.0 == label)
+        .map_or(0.0, |r| r.1)
+}
+
+#[test]
+fn inserting_a_surface_inside_one_region_keeps_the_rest() {
+    let (s, m) = nested();
+    // In the outer shell (region 1, between radii 1.5 and 4), an ellipsoid; and one inside the
+    // inner ball (region 2).
+    for (lesion, around) in [
+        (ball([2.7, 0.0, 0.3], 0.5, 1.4), 1),
+        (ball([0.1, 0.2, 0.0], 0.6, 1.5), 2),
+    ] {
+        let (out, r) = run_insert(&m, &lesion, 3, 0.3).unwrap();
+        // Kept tets are input tets, bit for bit, with their labels; new ones are not among them.
+        let old = tet_set(&m, 0..m.tets.len());
+        let kept = tet_set(&out, 0..r.tets_kept);
+        assert_eq!(kept.len(), r.tets_kept);
+        assert!(kept.is_subset(&old));
+        assert!(tet_set(&out, r.tets_kept..out.tets.len()).is_disjoint(&kept));
+        assert!(r.tets_kept > m.tets.len() / 2, "kept {}", r.tets_kept);
+        // Valid against the model's surface plus the lesion between labels 3 and `around`.
+        let c = check(&out, Some(&with_lesion(&s, &lesion, 3, around)));
+        assert!(c.valid, "{:?}", c.problems);
+        assert_adjacency(&out);
+        // Region 3 holds exactly the lesion's volume, taken from the region around it.
+        let v3 = volume_of(&out, 3);
+        let mut lesion_mesh = lesion.clone();
+        validate_surface(&mut lesion_mesh, &ValidateOptions::default()).unwrap();
+        let enclosed: f64 = lesion_mesh
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|v| lesion_mesh.points[v as usize]);
+                (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                    + a[2] * (b[0] * c[1] - b[1] * c[0]))
+                    / 6.0
+            })
+            .sum();
+        assert!(
+            (v3 - enclosed).abs() < 1e-9 * enclosed,
+            "{v3} vs {enclosed}"
+        );
+        let before = volume_of(&m, around);
+        let after = volume_of(&out, around) + v3;
+        assert!(
+            (before - after).abs() < 1e-9 * before,
+            "{before} vs {after}"
+        );
+        let other = 3 - around;
+        assert!(
+            (volume_of(&m, other) - volume_of(&out, other)).abs() < 1e-9 * volume_of(&m, other)
+        );
+        // Only new tets carry the new label.
+        assert!(out.labels[..r.tets_kept].iter().all(|&l| l != 3));
+    }
+}
+
+#[test]
+fn a_surface_inside_few_tets_and_no_margin() {
+    let (s, m) = nested();
+    // Smaller than the mesh size: it lies in a handful of tets, possibly inside one.
+    let lesion = ball([2.71, 0.13, -0.07], 0.05, 1.0);
+    let (out, r) = run_insert(&m, &lesion, 7, 0.0).unwrap();
+    assert!(
+        r.tets_before - r.tets_kept < 40,
+        "{}",
+        r.tets_before - r.tets_kept
+    );
+    let c = check(&out, Some(&with_lesion(&s, &lesion, 7, 1)));
+    assert!(c.valid, "{:?}", c.problems);
+}
+
+#[test]
+fn a_surface_meeting_an_interface_or_the_boundary_is_refused_naming_where() {
+    let (_, m) = nested();
+    let cases: [(SurfaceMesh, u32, &str); 6] = [
+        (
+            ball([1.5, 0.0, 0.0], 0.5, 1.0),
+            3,
+            "interface between regions 1 and 2",
+        ),
+        (
+            ball([4.0, 0.0, 0.0], 0.5, 1.0),
+            3,
+            "outer boundary of region 1",
+        ),
+        (
+            ball([0.0, 0.0, 0.0], 2.5, 1.0),
+            3,
+            "encloses part of the interface",
+        ),
+        (ball([10.0, 0.0, 0.0], 0.5, 1.0), 3, "outside the mesh"),
+        (ball([2.7, 0.0, 0.0], 0.5, 1.0), 1, "region around"),
+        (ball([2.7, 0.0, 0.0], 0.5, 1.0), 0, "outside"),
+    ];
+    for (lesion, label, what) in cases {
+        let e = run_insert(&m, &lesion, label, 0.2).unwrap_err().to_string();
+        assert!(e.contains(what), "{what}: {e}");
+    }
+    // The crossing message names the triangle and a point on both surfaces.
+    let lesion = ball([1.5, 0.0, 0.0], 0.5, 1.0);
+    match run_insert(&m, &lesion, 3, 0.2).unwrap_err() {
+        biotet::remesh::RemeshError::Crossing {
+            triangle, point, ..
+        } => {
+            assert!(triangle < lesion.triangles.len());
+            let r = (point[0] * point[0] + point[1] * point[1] + point[2] * point[2]).sqrt();
+            assert!(
+                (r - 1.5).abs() < 0.1,
+                "{point:?} is not on the inner sphere"
+            );
+            let d = ((point[0] - 1.5).powi(2) + point[1].powi(2) + point[2].powi(2)).sqrt();
+            assert!((d - 0.5).abs() < 0.05, "{point:?} is not on the lesion");
+        }
+        e => panic!("{e}"),
+    }
+}
+
+#[test]
+fn a_surface_touching_the_interface_at_one_point_is_refused_exactly() {
+    let (s, m) = nested();
+    // The inner ball's first vertex w (an icosahedron vertex, radius 1.5), and a lesion outside
+    // the inner ball whose vertex 3 (pointing at the origin) is put exactly on w: the two meet at
+    // that point only.
+    let w = s
+        .points
+        .iter()
+        .copied()
+        .find(|p| {
+            let r2 = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
+            (r2 - 2.25).abs() < 1e-9
+        })
+        .unwrap();
+    let r = 1.5;
+    let mut lesion = ball(
+        [
+            w[0] + 0.5 * w[0] / r,
+            w[1] + 0.5 * w[1] / r,
+            w[2] + 0.5 * w[2] / r,
+        ],
+        0.5,
+        1.0,
+    );
+    let k = (0..lesion.points.len())
+        .min_by(|&a, &b| {
+            let d = |p: [f64; 3]| (0..3).map(|i| (p[i] - w[i]).powi(2)).sum::<f64>();
+            d(lesion.points[a]).total_cmp(&d(lesion.points[b]))
+        })
+        .unwrap();
+    lesion.points[k] = w;
+    let e = run_insert(&m, &lesion, 3, 0.2).unwrap_err().to_string();
+    assert!(
+        e.contains("meets the interface between regions 1 and 2"),
+        "{e}"
+    );
+    // Moved off w by a hair towards the lesion's centre, it is accepted.
+    let c = [
+        w[0] + 0.5 * w[0] / r,
+        w[1] + 0.5 * w[1] / r,
+        w[2] + 0.5 * w[2] / r,
+    ];
+    lesion.points[k] = [0, 1, 2].map(|i| w[i] + 1e-6 * (c[i] - w[i]));
+    let (out, _) = run_insert(&m, &lesion, 3, 0.2).unwrap();
+    let c = check(&out, Some(&with_lesion(&s, &lesion, 3, 1)));
+    assert!(c.valid, "{:?}", c.problems);
+}
+
+#[test]
+fn shells_in_two_regions_are_refused() {
+    let (_, m) = nested();
+    let mut two = ball([2.7, 0.0, 0.0], 0.4, 1.0);
+    two.append(&ball([0.0, 0.0, 0.0], 0.5, 1.0));
+    let e = run_insert(&m, &two, 3, 0.2).unwrap_err().to_string();
+    assert!(e.contains("shells in regions 1 and 2"), "{e}");
 }
