@@ -63,7 +63,8 @@ run() {
 case "${1:-}" in
   build) build ;;
   run)
-    [ -x "$bin" ] || build
+    # Always: a stale binary would fuzz old code (a no-op build takes a fraction of a second).
+    build
     run "${2:-60}" "${@:3}"
     ;;
   seeds) cargo run -q -p biotet-fuzz --example seeds ;;
