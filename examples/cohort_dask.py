@@ -5,6 +5,10 @@ a summary CSV.
     python examples/cohort_dask.py subj01.stl subj02.stl ... -o meshes/            # LocalCluster
     python examples/cohort_dask.py subjects/*.stl -o meshes/ --workers 8 --size 2
     python examples/cohort_dask.py subjects/*.stl -o meshes/ --scheduler tcp://host:8786
+    python examples/cohort_dask.py seg/*.nii.gz -o meshes/ --keep-labels 2,41 --min-component-voxels 20
+
+A subject is a closed surface file or a label image (a segmentation: .nii, .nii.gz, .mgz, .nrrd,
+.mha, .vti...), meshed as ``biotet mesh FILE`` would.
 
 Each task meshes with ``threads=1`` so that workers do not oversubscribe the cores: run one
 worker process per core (the default here). biotet releases the GIL while it meshes, so threaded
@@ -29,7 +33,7 @@ import biotet
 
 SUMMARY_FIELDS = [
     "subject", "status", "seconds", "points", "tets", "min_dihedral_deg", "max_dihedral_deg",
-    "tets_under_10deg", "steiner_points", "mesh", "report", "error",
+    "tets_under_10deg", "steiner_points", "max_region_volume_error", "mesh", "report", "error",
 ]
 
 
@@ -69,6 +73,12 @@ def mesh_one(path: str, out_dir: str, options: dict) -> dict:
         max_dihedral_deg=f"{q['max_dihedral_deg']:.3f}",
         tets_under_10deg=q["n_dihedral_lt_10"],
         steiner_points=(m.report["pipeline"].get("recover") or {}).get("steiner_points", 0),
+        # A label image: the largest relative difference of a region's mesh and voxel volumes.
+        max_region_volume_error=max(
+            (abs(r["relative_error"]) for r in m.report.get("image_regions") or []
+             if r["relative_error"] is not None),
+            default="",
+        ),
         mesh=str(mesh_path),
         report=str(report_path),
     )
@@ -77,19 +87,26 @@ def mesh_one(path: str, out_dir: str, options: dict) -> dict:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("inputs", nargs="+", help="surface files, one subject each")
+    ap.add_argument("inputs", nargs="+", help="surface files or label images, one subject each")
     ap.add_argument("-o", "--out", required=True, help="output folder")
     ap.add_argument("--scheduler", help="address of a running Dask scheduler (default: a LocalCluster)")
     ap.add_argument("--workers", type=int, default=os.cpu_count() or 1,
                     help="LocalCluster worker processes (default: one per core)")
     ap.add_argument("--size", type=float, help="uniform size (default: from each surface)")
+    ap.add_argument("--keep-labels", help="label images: keep only these labels, as L,L,...")
+    ap.add_argument("--min-component-voxels", type=int, default=0,
+                    help="label images: merge smaller islands into their surroundings")
     a = ap.parse_args(argv)
 
     from dask.distributed import Client, LocalCluster
 
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
-    options = {"size": a.size} if a.size else {}
+    options: dict = {"size": a.size} if a.size else {}
+    if a.keep_labels:
+        options["keep_labels"] = [int(x) for x in a.keep_labels.split(",")]
+    if a.min_component_voxels:
+        options["min_component_voxels"] = a.min_component_voxels
     if a.scheduler:
         client = Client(a.scheduler)
         cluster = None

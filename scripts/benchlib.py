@@ -148,6 +148,25 @@ def mmg3d():
     return shutil.which("mmg3d_O3") or shutil.which("mmg3d")
 
 
+def cgal_mesh3():
+    """CGAL Mesh_3's driver (scripts/cgal/mesh3.cpp), built on first use into $CARGO_TARGET_DIR (or target/)/cgal
+    with g++ against Debian's libcgal-dev; None (and why, on stderr) when it cannot be built here."""
+    target = os.environ.get("CARGO_TARGET_DIR") or os.path.join(ROOT, "target")
+    exe = os.path.join(target, "cgal", "mesh3")
+    src = os.path.join(ROOT, "scripts", "cgal", "mesh3.cpp")
+    if os.path.exists(exe) and os.path.getmtime(exe) >= os.path.getmtime(src):
+        return exe
+    if not (os.path.isdir("/usr/include/CGAL") and shutil.which("g++")):
+        return None
+    os.makedirs(os.path.dirname(exe), exist_ok=True)
+    r = subprocess.run(["g++", "-O2", "-DNDEBUG", "-std=c++17", src, "-o", exe, "-lgmp", "-lmpfr"],
+                       capture_output=True, text=True)
+    if r.returncode != 0:
+        print(f"building {src} failed: {r.stderr.strip()[-500:]}", file=sys.stderr)
+        return None
+    return exe
+
+
 def median(rows, key):
     """Median of `key` over the rows that have it (None if none has)."""
     vals = [r[key] for r in rows if r.get(key) is not None]

@@ -11,6 +11,8 @@ Installs nothing. The anchors come from PyPI (each is skipped, and said so, when
 
 (pytetwild 0.4 imports pyvista at import time without declaring it: `pip install pyvista` too if it complains.)
 
+(CGAL: `apt install libcgal-dev g++`.)
+
 Tools, each on every surface (default: the real surfaces bundled in tests/data, brain_20k.stl and wm_20k.stl):
   biotet        `biotet mesh SURFACE` with its default options (the full pipeline; surface kept exactly)
   tetgen        TetGen 1.6 (pip `tetgen`) `pq1.2Y`: quality refinement, surface kept (no point added on it)
@@ -20,6 +22,9 @@ Tools, each on every surface (default: the real surfaces bundled in tests/data, 
                 edges (Gmsh's default), Gmsh's default 3D optimisation, one thread
   ftetwild      fTetWild through pytetwild, its default ideal edge length (bounding-box diagonal / 20), one thread:
                 the surface is approximated within fTetWild's envelope, not kept
+  cgal          CGAL 5.5 Mesh_3 (scripts/cgal/mesh3.cpp, built on first use with g++ against Debian's libcgal-dev): the
+                surface as a polyhedral domain with its sharp edges protected, every size the mean input edge, facet
+                distance an eighth of it, perturb and exude; the surface is resampled, not kept
   mmg           MMG3D `-optim -nosurf` on the TetGen `pq1.2Y` mesh (surface untouched); MMG rescales the mesh to a
                 unit box and writes 15 digits, so its points within 1e-9 of the bounding-box diagonal of an input
                 point are snapped back onto it before measuring (the count is in the notes)
@@ -58,6 +63,7 @@ TOOLS = {
     "gmsh": ("Gmsh 3D Delaunay (surface kept)", ["numpy", "meshio", "gmsh"]),
     "ftetwild": ("fTetWild (pytetwild)", ["numpy", "meshio", "pytetwild"]),
     "mmg": ("MMG3D `-optim -nosurf` on TetGen `pq1.2Y`", ["numpy", "meshio", "tetgen"]),
+    "cgal": ("CGAL 5.5 Mesh_3 (features protected)", []),
 }
 BEGIN, END = "<!-- compare:begin -->", "<!-- compare:end -->"
 
@@ -75,6 +81,8 @@ def missing_requirement(tool):
             return f"Python module `{m}` not installed"
     if tool == "mmg" and not benchlib.mmg3d():
         return "mmg3d not found (pip install pymmg)"
+    if tool == "cgal" and not benchlib.cgal_mesh3():
+        return "CGAL's driver could not be built (apt install libcgal-dev g++)"
     return None
 
 
@@ -147,6 +155,24 @@ class Runner:
         shutil.copyfile(raw + ".ele", final + ".ele")
         write_node_like(raw + ".node", final + ".node", points)
         return final + ".node", rows, f"{moved} points snapped onto the input surface"
+
+    def cgal(self):
+        """CGAL Mesh_3 on the surface as a polyhedral domain with its sharp edges protected: every size the mean
+        input edge, facet distance an eighth of it, facet angle 25°, radius-edge ratio 3, perturb and exude."""
+        off = self.path("cgal_input.off")
+        biotet_json(self.biotet, "convert", self.surface, "-o", off, ok=(0,))
+        p, t = benchlib.read_surface(self.surface)
+        import numpy as np
+        e = np.concatenate([p[t[:, 1]] - p[t[:, 0]], p[t[:, 2]] - p[t[:, 1]], p[t[:, 0]] - p[t[:, 2]]])
+        h = float(np.linalg.norm(e, axis=1).mean())
+        out, rows = self.path("cgal.mesh"), []
+        for _ in range(self.repeat):
+            wall, peak, r = run_binary([benchlib.cgal_mesh3(), "surface", off, out, repr(h), repr(h), repr(h / 8), repr(h)])
+            if r.returncode != 0:
+                raise RuntimeError(f"mesh3: {(r.stderr or r.stdout).strip()[-300:]}")
+            j = json.loads(r.stdout.strip().splitlines()[-1])
+            rows.append({"seconds": j["seconds"], "wall": wall, "kb": peak})
+        return out, rows, f"surface resampled (sizes {h:.2f}, facet distance {h / 8:.2f}); peak MB is the whole process"
 
     def run(self, tool):
         """Run `tool`: returns (output mesh, one dict per run with seconds, wall and kb, a note)."""

@@ -10,10 +10,12 @@ cargo test --workspace --locked
 if [ "${BIOTET_FUZZ_SECONDS:-3}" != 0 ]; then
   scripts/fuzz.sh run "${BIOTET_FUZZ_SECONDS:-3}"
 fi
-venv=target/pyenv
+# The CLI the Python tests compare with is cargo's, wherever CARGO_TARGET_DIR puts it.
+target_dir=$(realpath -m "${CARGO_TARGET_DIR:-target}")
+venv="$target_dir/pyenv"
 if [ ! -x "$venv/bin/python" ]; then
   "${PYTHON:-python3}" -m venv "$venv"
 fi
 "$venv/bin/python" -m pip install -q --upgrade pip
 "$venv/bin/python" -m pip install -q ./crates/biotet-py pytest meshio pyvista "dask[distributed]"
-BIOTET_CLI="$PWD/target/debug/biotet" "$venv/bin/python" -m pytest -q crates/biotet-py/tests
+BIOTET_CLI="$target_dir/debug/biotet" "$venv/bin/python" -m pytest -q crates/biotet-py/tests

@@ -11,6 +11,7 @@ mod memory;
 mod output;
 mod plot;
 mod progress;
+mod view;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -73,6 +74,9 @@ enum Command {
     Surface(cmd::surface::Args),
     /// Validate closed surfaces: closed, manifold, consistently oriented, no self-intersection.
     Validate(cmd::validate::Args),
+    /// Draw a tet mesh as SVG or PNG: the tets a plane cuts, coloured by region or by
+    /// quality, or the boundary seen from one viewpoint.
+    View(cmd::view::Args),
     /// The former name of `surface IMAGE` (kept for scripts).
     #[command(hide = true)]
     SurfaceExtract(cmd::extract::Args),
@@ -102,6 +106,10 @@ fn main() -> ExitCode {
         default_hook(info);
     }));
     let cli = Cli::parse();
+    // The documentation test parses every command line of the docs without running it.
+    if std::env::var_os("BIOTET_PARSE_ONLY").is_some() {
+        return ExitCode::SUCCESS;
+    }
     if let Some(n) = cli.threads
         && let Err(e) = rayon::ThreadPoolBuilder::new()
             .num_threads(n)
@@ -128,6 +136,7 @@ fn main() -> ExitCode {
         Command::Smooth(a) => cmd::smooth::run(a),
         Command::SurfaceExtract(a) => cmd::extract::run(a),
         Command::Surface(a) => cmd::surface::run(a),
+        Command::View(a) => cmd::view::run(a),
     };
     match result {
         Ok(code) => code,

@@ -683,7 +683,7 @@ mod tests {
         assert!(format!("{err:#}").contains("q.svg"), "{err:#}");
     }
 
-    /// The JSON keys the README and the CLI document, present in both reports.
+    /// The JSON keys docs/commands.md and the CLI document, present in both reports.
     #[test]
     fn json_keys() {
         let j = serde_json::to_value(QualityReport::of(&mesh())).unwrap();

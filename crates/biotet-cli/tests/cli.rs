@@ -38,7 +38,7 @@ fn help_everywhere() {
     }
 }
 
-/// Every JSON key the README documents for `biotet quality --json`.
+/// Every JSON key docs/commands.md documents for `biotet quality --json`.
 const QUALITY_KEYS: &[&str] = &[
     "n_points",
     "n_tets",

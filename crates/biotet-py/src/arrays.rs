@@ -3,9 +3,13 @@
 //! vectors into numpy without a copy.
 
 use biotet::mesh::shells::Part;
+use biotet::sizing_grid::ScalarGrid;
 use biotet::{SurfaceMesh, TetMesh};
 use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::{
+    Element, IntoPyArray, PyArray2, PyReadonlyArray, PyReadonlyArray2, PyReadonlyArray3,
+    PyUntypedArrayMethods,
+};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
@@ -39,37 +43,70 @@ pub fn points_from(a: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<[f64; 3]>> {
     Ok(v.rows().into_iter().map(|r| [r[0], r[1], r[2]]).collect())
 }
 
-/// Index rows of width `N` from an int64 array, each in `0..n_points`.
+/// Integer arrays as numpy holds them: int32 (what biotet returns) or int64 (numpy's default
+/// elsewhere), read in place either way.
+macro_rules! int_array {
+    ($name:ident, $dim:ty, $what:literal) => {
+        #[doc = $what]
+        #[derive(FromPyObject)]
+        pub enum $name<'py> {
+            I32(PyReadonlyArray<'py, i32, $dim>),
+            I64(PyReadonlyArray<'py, i64, $dim>),
+        }
+
+        impl $name<'_> {
+            fn shape(&self) -> &[usize] {
+                match self {
+                    $name::I32(a) => a.shape(),
+                    $name::I64(a) => a.shape(),
+                }
+            }
+
+            /// Every value, in logical order, as i64.
+            fn values(&self) -> Box<dyn Iterator<Item = i64> + '_> {
+                match self {
+                    $name::I32(a) => Box::new(a.as_array().into_iter().map(|&x| x as i64)),
+                    $name::I64(a) => Box::new(a.as_array().into_iter().copied()),
+                }
+            }
+        }
+    };
+}
+
+int_array!(Ints2, numpy::Ix2, "An (n, k) int32 or int64 array.");
+int_array!(Ints1, numpy::Ix1, "An (n,) int32 or int64 array.");
+
+/// Index rows of width `N`, each in `0..n_points`.
 fn indices_from<const N: usize>(
     what: &str,
-    a: &PyReadonlyArray2<'_, i64>,
+    a: &Ints2<'_>,
     n_points: usize,
 ) -> PyResult<Vec<[u32; N]>> {
-    let v = a.as_array();
-    if v.ncols() != N {
-        return Err(shape_error(what, N, v.shape()));
+    let shape = a.shape();
+    if shape[1] != N {
+        return Err(shape_error(what, N, shape));
     }
-    let mut out = Vec::with_capacity(v.nrows());
-    for (i, r) in v.rows().into_iter().enumerate() {
-        let mut row = [0u32; N];
-        for (k, x) in r.iter().enumerate() {
-            if *x < 0 || *x as u64 >= n_points as u64 {
-                return Err(PyValueError::new_err(format!(
-                    "{what}[{i}] refers to point {x}, outside 0..{n_points}"
-                )));
-            }
-            row[k] = *x as u32;
+    let mut out = Vec::with_capacity(shape[0]);
+    let mut row = [0u32; N];
+    for (at, x) in a.values().enumerate() {
+        if x < 0 || x as u64 >= n_points as u64 {
+            return Err(PyValueError::new_err(format!(
+                "{what}[{}] refers to point {x}, outside 0..{n_points}",
+                at / N
+            )));
         }
-        out.push(row);
+        row[at % N] = x as u32;
+        if at % N == N - 1 {
+            out.push(row);
+        }
     }
     Ok(out)
 }
 
-/// Labels from an int64 array of length `n`, each in `0..2³²`.
-fn labels_from(what: &str, a: &[i64]) -> PyResult<Vec<u32>> {
-    a.iter()
-        .enumerate()
-        .map(|(i, &l)| {
+/// Labels, each in `0..2³²`.
+fn labels_from(what: &str, a: impl Iterator<Item = i64>) -> PyResult<Vec<u32>> {
+    a.enumerate()
+        .map(|(i, l)| {
             u32::try_from(l).map_err(|_| {
                 PyValueError::new_err(format!("{what}[{i}] = {l} is not a label in 0..2**32"))
             })
@@ -80,9 +117,9 @@ fn labels_from(what: &str, a: &[i64]) -> PyResult<Vec<u32>> {
 /// A surface from points, triangles and either shell labels or side labels.
 pub fn surface_from(
     points: &PyReadonlyArray2<'_, f64>,
-    triangles: &PyReadonlyArray2<'_, i64>,
+    triangles: &Ints2<'_>,
     shell_labels: Option<Vec<u32>>,
-    side_labels: Option<&PyReadonlyArray2<'_, i64>>,
+    side_labels: Option<&Ints2<'_>>,
     name: String,
 ) -> PyResult<Surface> {
     let pts = points_from(points)?;
@@ -90,15 +127,13 @@ pub fn surface_from(
     let n = tris.len();
     match side_labels {
         Some(sides) => {
-            let v = sides.as_array();
-            if v.ncols() != 2 || v.nrows() != n {
+            if sides.shape() != [n, 2] {
                 return Err(PyValueError::new_err(format!(
                     "side_labels must have shape ({n}, 2), not {:?}",
-                    v.shape()
+                    sides.shape()
                 )));
             }
-            let flat: Vec<i64> = v.iter().copied().collect();
-            let l = labels_from("side_labels", &flat)?;
+            let l = labels_from("side_labels", sides.values())?;
             let mut s = SurfaceMesh::closed(pts, tris, 1);
             s.sides = l.chunks_exact(2).map(|c| [c[0], c[1]]).collect();
             Ok(Surface::Sided(s, name))
@@ -113,24 +148,61 @@ pub fn surface_from(
     }
 }
 
+/// The values of a 3D array `a[i, j, k]` with `i` fastest (the order of `LabelImage` and
+/// `ScalarGrid`) and its shape: one copy, a `memcpy` when the array is Fortran-ordered (as
+/// nibabel's are).
+pub fn volume_from<T: Element + Copy>(a: &PyReadonlyArray3<'_, T>) -> (Vec<T>, [usize; 3]) {
+    let v = a.as_array();
+    let dims = [v.shape()[0], v.shape()[1], v.shape()[2]];
+    // Axes reversed, the logical order is `i` fastest; contiguous when `a` is Fortran-ordered.
+    let t = v.reversed_axes();
+    let values = match t.as_slice() {
+        Some(s) => s.to_vec(),
+        None => t.iter().copied().collect(),
+    };
+    (values, dims)
+}
+
+/// A size field from samples `values[i, j, k]` at `affine · (i, j, k, 1)`: the affine's columns
+/// give each grid axis's direction and spacing.
+pub fn grid_from(
+    values: &PyReadonlyArray3<'_, f64>,
+    affine: &[[f64; 4]; 4],
+) -> PyResult<ScalarGrid> {
+    let (values, dims) = volume_from(values);
+    let spacing: [f64; 3] = std::array::from_fn(|c| {
+        (0..3)
+            .map(|r| affine[r][c] * affine[r][c])
+            .sum::<f64>()
+            .sqrt()
+    });
+    let direction: [[f64; 3]; 3] =
+        std::array::from_fn(|r| std::array::from_fn(|c| affine[r][c] / spacing[c]));
+    let origin = [affine[0][3], affine[1][3], affine[2][3]];
+    ScalarGrid::new(dims, origin, spacing, direction, values)
+        .map_err(|e| PyValueError::new_err(format!("size_field: {e}")))
+}
+
 /// A tet mesh from points, tets and labels (adjacency rebuilt).
 pub fn mesh_from(
     points: &PyReadonlyArray2<'_, f64>,
-    tets: &PyReadonlyArray2<'_, i64>,
-    labels: &PyReadonlyArray1<'_, i64>,
+    tets: &Ints2<'_>,
+    labels: &Ints1<'_>,
 ) -> PyResult<TetMesh> {
     let pts = points_from(points)?;
     let t = indices_from::<4>("tets", tets, pts.len())?;
-    let l = labels.as_array();
-    if l.len() != t.len() {
+    let n = labels.shape()[0];
+    if n != t.len() {
         return Err(PyValueError::new_err(format!(
-            "labels has {} entries for {} tets",
-            l.len(),
+            "labels has {n} entries for {} tets",
             t.len()
         )));
     }
-    let flat: Vec<i64> = l.iter().copied().collect();
-    Ok(TetMesh::new(pts, t, labels_from("labels", &flat)?))
+    Ok(TetMesh::new(
+        pts,
+        t,
+        labels_from("labels", labels.values())?,
+    ))
 }
 
 /// Reinterpret indices as int32 (numpy's default index type) without a copy: every index is

@@ -5,14 +5,23 @@
 //!
 //! Inputs are borrowed read-only from numpy and copied once into the library's types (the
 //! library owns its arrays); outputs are moved into numpy without a copy.
+//!
+//! Meshing follows `biotet mesh` step for step, through the same library calls, so the bytes
+//! written are the CLI's: a surface validated (shells assembled, or side labels resolved), or a
+//! label image through `image::surface::labelled_surface` with its labels renumbered for the
+//! template and put back after; sizes from `SizeSpec::from_grid` for a size field.
 
 mod arrays;
 mod run;
 
-use arrays::{Surface, mesh_from, mesh_out, points_from, surface_from};
-use biotet::TetMesh;
+use arrays::{
+    Ints1, Ints2, Surface, grid_from, mesh_from, mesh_out, points_from, surface_from, volume_from,
+};
 use biotet::check::check as check_mesh;
 use biotet::delaunay::Delaunay;
+use biotet::image::LabelImage;
+use biotet::image::labels::{Compaction, LabelOptions};
+use biotet::image::surface::{ImageSummary, ImageSurfaceError, labelled_surface};
 use biotet::lastresort::{ImproveOptions, Metric, RecoverOptions, improve, recover};
 use biotet::mesh::shells::{Part, assemble};
 use biotet::mesh::side_labels;
@@ -20,9 +29,11 @@ use biotet::mesh::validate::{ValidateOptions, validate_surface};
 use biotet::pipeline::{PipelineOptions, mesh_surface};
 use biotet::quality::{QualityReport, forced};
 use biotet::sizing::{SizeSpec, Sizing, SizingOptions};
+use biotet::sizing_grid::ScalarGrid;
 use biotet::smooth::{Boundary, SmoothOptions, smooth};
 use biotet::template::Zone;
-use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use biotet::{SurfaceMesh, TetMesh};
+use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray2, PyReadonlyArray3};
 use pyo3::prelude::*;
 use run::{Failure, Kind, guarded};
 use serde_json::json;
@@ -72,11 +83,81 @@ struct MeshOptions {
     steiner: bool,
     stages: [bool; 4],
     surface_tolerance: Option<f64>,
+    surface_feature_angle: f64,
+    surface_rounds: usize,
+    adaptive_size: bool,
+    size_field: Option<SizeFieldIn>,
+}
+
+/// A size field as given (`--size-field`): a file (.vti with an optional array name, NIfTI), or
+/// samples `values[i, j, k]` at `affine · (i, j, k, 1)`.
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
+struct SizeFieldIn {
+    path: Option<PathBuf>,
+    array: Option<String>,
+    values: Option<Py<PyArray3<f64>>>,
+    affine: Option<[[f64; 4]; 4]>,
+}
+
+/// A size field ready for meshing: a file is read with the GIL released, with the rest.
+enum SizeField {
+    File(PathBuf, Option<String>),
+    Grid(ScalarGrid),
+}
+
+impl SizeFieldIn {
+    /// Copy numpy samples into a grid (needs the GIL).
+    fn resolve(self, py: Python<'_>) -> PyResult<SizeField> {
+        match (self.path, self.values, self.affine) {
+            (Some(p), None, _) => Ok(SizeField::File(p, self.array)),
+            (None, Some(v), Some(a)) => {
+                let v = v.bind(py).try_readonly().map_err(|e| {
+                    pyo3::exceptions::PyValueError::new_err(format!("size_field: {e}"))
+                })?;
+                Ok(SizeField::Grid(grid_from(&v, &a)?))
+            }
+            _ => Err(pyo3::exceptions::PyValueError::new_err(
+                "size_field: give a path, or values with their affine",
+            )),
+        }
+    }
+}
+
+/// How an image's values become regions, as the CLI's `--labels`, `--merge`, `--outside`,
+/// `--min-component-voxels`: a dict from the Python layer (`biotet._image_options`).
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
+struct ImageOptions {
+    keep: Option<Vec<u32>>,
+    merge: Vec<(Vec<u32>, u32)>,
+    outside: u32,
+    min_component_voxels: usize,
+}
+
+impl ImageOptions {
+    fn to_library(&self) -> LabelOptions {
+        LabelOptions {
+            keep: self.keep.clone(),
+            merge: self.merge.clone(),
+            outside: self.outside,
+            min_component_voxels: self.min_component_voxels,
+        }
+    }
+}
+
+/// A surface ready for the pipeline: validated, its shells (for the report), the input's name,
+/// and for an image the summary of its extraction.
+struct Prepared {
+    surface: SurfaceMesh,
+    shells: serde_json::Value,
+    name: String,
+    image: Option<ImageSummary>,
 }
 
 /// Validate a labelled surface as `biotet mesh` does: shells assembled and labelled innermost
 /// first, or the file's own side labels resolved against the geometry.
-fn prepare(surface: Surface) -> Result<(biotet::SurfaceMesh, serde_json::Value), Failure> {
+fn prepare(surface: Surface) -> Result<(SurfaceMesh, serde_json::Value), Failure> {
     let opts = ValidateOptions::default();
     match surface {
         Surface::Parts(parts, name) => {
@@ -111,23 +192,65 @@ fn prepare(surface: Surface) -> Result<(biotet::SurfaceMesh, serde_json::Value),
     }
 }
 
-/// The pipeline on a surface, with the report `biotet mesh --json` gives (without its
-/// process-level figures: memory, reading time).
+/// The labelled surface of a label image as `biotet mesh IMAGE` makes it (label options,
+/// extraction, validation), named `name`; `seconds_read` is the time its file took to read.
+fn prepare_image(
+    img: LabelImage,
+    opts: &ImageOptions,
+    name: String,
+    seconds_read: f64,
+    progress: &dyn Fn(&str),
+) -> Result<Prepared, Failure> {
+    let (surface, mut summary) =
+        labelled_surface(img, &opts.to_library(), &name, &mut |s| progress(s)).map_err(
+            |e| match e {
+                ImageSurfaceError::Labels(e) => Failure::new(Kind::Value, format!("{name}: {e}")),
+                ImageSurfaceError::Surface(e) => Failure {
+                    kind: Kind::InvalidSurface,
+                    message: format!("{name}: the extracted surface: {e}"),
+                    triangles: e.triangles(),
+                },
+            },
+        )?;
+    summary.seconds_read = seconds_read;
+    Ok(Prepared {
+        surface,
+        shells: json!([]),
+        name,
+        image: Some(summary),
+    })
+}
+
+/// The pipeline on a validated surface, with the report `biotet mesh --json` gives (without
+/// its process-level figures: memory, reading time), as `biotet mesh` runs it: an image's
+/// labels renumbered for the template and put back after, an oblique image meshed in its
+/// frame and the mesh rotated to world.
 fn mesh_with(
-    surface: Surface,
+    input: Prepared,
     o: &MeshOptions,
+    field: Option<SizeField>,
     progress: &dyn Fn(&str),
 ) -> Result<(TetMesh, serde_json::Value), Failure> {
-    let name = surface.name().to_string();
-    let (surface, shells) = prepare(surface)?;
+    let Prepared {
+        mut surface,
+        shells,
+        name,
+        image,
+    } = input;
+    // Image labels are the image's values; the template holds small labels.
+    let compaction = image.as_ref().map(|_| Compaction::of_surface(&mut surface));
+    let frame_to_world = image.as_ref().and_then(|i| i.frame_to_world);
     // The opt-in surface stage (as `biotet mesh --surface-tolerance D`).
-    let (surface, surface_report) = match o.surface_tolerance {
+    let (mut surface, surface_report) = match o.surface_tolerance {
         None => (surface, None),
         Some(d) => {
             progress("improving the surface");
             let so = biotet::surface::SurfaceOptions {
                 tolerance: d,
                 edge_length: o.size,
+                feature_angle_deg: o.surface_feature_angle,
+                rounds: o.surface_rounds,
+                adaptive: o.adaptive_size,
                 ..Default::default()
             };
             let (s, r) = biotet::surface::improve(&surface, &so)
@@ -135,15 +258,37 @@ fn mesh_with(
             (s, Some(r))
         }
     };
-    let spec = match o.size {
-        Some(h) => SizeSpec::Uniform(h),
-        None => SizeSpec::FromSurface { grading: o.grading },
+    let clock = std::time::Instant::now();
+    let spec = match (o.size, field) {
+        (Some(h), _) => SizeSpec::Uniform(h),
+        (None, Some(field)) => {
+            let (grid, what) = match field {
+                SizeField::File(path, array) => (
+                    biotet_io::read_scalar_grid_named(&path, array.as_deref())
+                        .map_err(Failure::io)?,
+                    path.display().to_string(),
+                ),
+                SizeField::Grid(g) => (g, "size_field".to_string()),
+            };
+            SizeSpec::from_grid(grid, frame_to_world)
+                .map_err(|e| Failure::new(Kind::Value, format!("{what}: {e}")))?
+        }
+        (None, None) => SizeSpec::FromSurface { grading: o.grading },
     };
     let mut sizing = SizingOptions::new(spec);
     sizing.min_size = o.min_size;
     sizing.max_size = o.max_size;
     sizing.region_sizes = o.region_sizes.clone();
-    let clock = std::time::Instant::now();
+    if let Some(c) = &compaction {
+        for (l, _) in sizing.region_sizes.iter_mut() {
+            *l = c.compact(*l).ok_or_else(|| {
+                Failure::new(
+                    Kind::Value,
+                    format!("region_sizes: no region {l} in the image"),
+                )
+            })?;
+        }
+    }
     let sizing = Sizing::new(&surface, sizing)
         .map_err(|e| Failure::new(Kind::Value, format!("sizing: {e}")))?;
     let seconds_sizing = clock.elapsed().as_secs_f64();
@@ -176,8 +321,17 @@ fn mesh_with(
     if !polish_on || !improve_on {
         opts.polish = None;
     }
-    let (mesh, report) = mesh_surface(&surface, sizing, &opts, &mut |s| progress(s))
+    let (mut mesh, report) = mesh_surface(&surface, sizing, &opts, &mut |s| progress(s))
         .map_err(|e| Failure::new(Kind::Meshing, format!("{name}: {e}")))?;
+    if let Some(c) = &compaction {
+        c.restore_tets(&mut mesh);
+        c.restore_surface(&mut surface);
+    }
+    if let Some(m) = &frame_to_world {
+        // Meshed in the image's frame; a rotation (positive determinant) to world.
+        biotet::image::map_points(m, &mut mesh.points);
+        biotet::image::map_points(m, &mut surface.points);
+    }
     let quality = QualityReport::of(&mesh);
     let forcing = forced::summarise(
         &mesh,
@@ -195,6 +349,7 @@ fn mesh_with(
             triangles,
         });
     }
+    let image_regions = image.as_ref().map(|i| i.region_volumes(&quality));
     let mut report = json!({
         "input": name,
         "n_surface_triangles": surface.triangles.len(),
@@ -204,11 +359,25 @@ fn mesh_with(
         "quality": quality,
         "forcing": forcing,
         "mesh_bytes": mesh.bytes(),
+        "image": image,
+        "image_regions": image_regions,
     });
     if let Some(r) = surface_report {
         report["surface"] = serde_json::to_value(r).unwrap_or_default();
     }
     Ok((mesh, report))
+}
+
+/// The validated surface of `prepare` as the pipeline's input.
+fn prepared(surface: Surface) -> Result<Prepared, Failure> {
+    let name = surface.name().to_string();
+    let (surface, shells) = prepare(surface)?;
+    Ok(Prepared {
+        surface,
+        shells,
+        name,
+        image: None,
+    })
 }
 
 /// Refuse a zone other than the two the template knows.
@@ -229,15 +398,20 @@ fn check_zone(o: &MeshOptions) -> PyResult<()> {
 fn mesh_arrays<'py>(
     py: Python<'py>,
     points: PyReadonlyArray2<'py, f64>,
-    triangles: PyReadonlyArray2<'py, i64>,
+    triangles: Ints2<'py>,
     shell_labels: Option<Vec<u32>>,
-    side_labels: Option<PyReadonlyArray2<'py, i64>>,
+    side_labels: Option<Ints2<'py>>,
     name: String,
-    options: MeshOptions,
+    mut options: MeshOptions,
     threads: Option<usize>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<MeshOut<'py>> {
     check_zone(&options)?;
+    let field = options
+        .size_field
+        .take()
+        .map(|f| f.resolve(py))
+        .transpose()?;
     let surface = surface_from(
         &points,
         &triangles,
@@ -246,30 +420,137 @@ fn mesh_arrays<'py>(
         name,
     )?;
     let (mesh, report) = guarded(py, threads, move || {
-        mesh_with(surface, &options, &|s| {
-            run::report_progress(progress.as_ref(), s)
-        })
+        let progress = |s: &str| run::report_progress(progress.as_ref(), s);
+        mesh_with(prepared(surface)?, &options, field, &progress)
     })?;
     Ok(mesh_out(py, mesh, report.to_string()))
 }
 
-/// Mesh the volume inside the closed surfaces in files (see `biotet.mesh_file`).
+/// Mesh the regions of a label volume (see `biotet.mesh_image`): `labels[i, j, k]` is the
+/// label of the voxel centred at `affine · (i, j, k, 1)`.
 #[pyfunction]
-#[pyo3(signature = (paths, labels, options, threads, progress))]
-fn mesh_files<'py>(
+#[pyo3(signature = (labels, affine, name, image, options, threads, progress))]
+#[allow(clippy::too_many_arguments)]
+fn mesh_image<'py>(
     py: Python<'py>,
-    paths: Vec<PathBuf>,
-    labels: Vec<Option<Vec<u32>>>,
-    options: MeshOptions,
+    labels: PyReadonlyArray3<'py, u32>,
+    affine: [[f64; 4]; 4],
+    name: String,
+    image: ImageOptions,
+    mut options: MeshOptions,
     threads: Option<usize>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<MeshOut<'py>> {
     check_zone(&options)?;
+    let field = options
+        .size_field
+        .take()
+        .map(|f| f.resolve(py))
+        .transpose()?;
+    let (values, dims) = volume_from(&labels);
+    let img = LabelImage::new(dims, affine, values)
+        .map_err(|e| pyo3::exceptions::PyValueError::new_err(format!("labels: {e}")))?;
     let (mesh, report) = guarded(py, threads, move || {
-        let surface = read_surfaces(&paths, labels)?;
-        mesh_with(surface, &options, &|s| {
-            run::report_progress(progress.as_ref(), s)
-        })
+        let progress = |s: &str| run::report_progress(progress.as_ref(), s);
+        let input = prepare_image(img, &image, name, 0.0, &progress)?;
+        mesh_with(input, &options, field, &progress)
+    })?;
+    Ok(mesh_out(py, mesh, report.to_string()))
+}
+
+/// The labelled surface of a label image in world coordinates, as `biotet surface IMAGE`
+/// writes it.
+fn extracted(img: LabelImage, opts: &ImageOptions, name: String) -> Result<SurfaceMesh, Failure> {
+    let p = prepare_image(img, opts, name, 0.0, &|_| {})?;
+    let mut s = p.surface;
+    if let Some(m) = p.image.and_then(|i| i.frame_to_world) {
+        biotet::image::map_points(&m, &mut s.points);
+    }
+    Ok(s)
+}
+
+/// The labelled surface of a label volume (see `biotet.surface_extract`): `labels[i, j, k]` is
+/// the label of the voxel centred at `affine · (i, j, k, 1)`.
+#[pyfunction]
+#[pyo3(signature = (labels, affine, name, image))]
+fn surface_image<'py>(
+    py: Python<'py>,
+    labels: PyReadonlyArray3<'py, u32>,
+    affine: [[f64; 4]; 4],
+    name: String,
+    image: ImageOptions,
+) -> PyResult<SurfaceOut<'py>> {
+    let (values, dims) = volume_from(&labels);
+    let img = LabelImage::new(dims, affine, values)
+        .map_err(|e| pyo3::exceptions::PyValueError::new_err(format!("labels: {e}")))?;
+    let s = guarded(py, None, move || extracted(img, &image, name))?;
+    Ok(arrays::surface_out(py, s))
+}
+
+/// The labelled surface of a label image file (see `biotet.surface_extract`).
+#[pyfunction]
+#[pyo3(signature = (path, image))]
+fn surface_image_file<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    image: ImageOptions,
+) -> PyResult<SurfaceOut<'py>> {
+    let s = guarded(py, None, move || {
+        if !biotet_io::is_label_image(&path) {
+            return Err(Failure::new(
+                Kind::File,
+                format!(
+                    "{}: not a label image ({})",
+                    path.display(),
+                    biotet_io::image::IMAGE_EXTENSIONS
+                ),
+            ));
+        }
+        let img = biotet_io::read_label_image(&path).map_err(Failure::io)?;
+        extracted(img, &image, path.display().to_string())
+    })?;
+    Ok(arrays::surface_out(py, s))
+}
+
+/// Mesh the volume inside the closed surfaces in files (see `biotet.mesh_file`).
+#[pyfunction]
+#[pyo3(signature = (paths, labels, image, options, threads, progress))]
+#[allow(clippy::too_many_arguments)]
+fn mesh_files<'py>(
+    py: Python<'py>,
+    paths: Vec<PathBuf>,
+    labels: Vec<Option<Vec<u32>>>,
+    image: ImageOptions,
+    mut options: MeshOptions,
+    threads: Option<usize>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<MeshOut<'py>> {
+    check_zone(&options)?;
+    let field = options
+        .size_field
+        .take()
+        .map(|f| f.resolve(py))
+        .transpose()?;
+    let (mesh, report) = guarded(py, threads, move || {
+        let progress = |s: &str| run::report_progress(progress.as_ref(), s);
+        let input = match &paths[..] {
+            // One label image: its labelled surface, as `biotet mesh IMAGE`.
+            [path] if biotet_io::is_label_image(path) => {
+                let clock = std::time::Instant::now();
+                progress(&format!("reading {}", path.display()));
+                let img = biotet_io::read_label_image(path).map_err(Failure::io)?;
+                let seconds_read = clock.elapsed().as_secs_f64();
+                prepare_image(
+                    img,
+                    &image,
+                    path.display().to_string(),
+                    seconds_read,
+                    &progress,
+                )?
+            }
+            _ => prepared(read_surfaces(&paths, labels)?)?,
+        };
+        mesh_with(input, &options, field, &progress)
     })?;
     Ok(mesh_out(py, mesh, report.to_string()))
 }
@@ -319,12 +600,12 @@ fn read_surfaces(paths: &[PathBuf], labels: Vec<Option<Vec<u32>>>) -> Result<Sur
 fn check<'py>(
     py: Python<'py>,
     points: PyReadonlyArray2<'py, f64>,
-    tets: PyReadonlyArray2<'py, i64>,
-    labels: PyReadonlyArray1<'py, i64>,
+    tets: Ints2<'py>,
+    labels: Ints1<'py>,
     surface_points: Option<PyReadonlyArray2<'py, f64>>,
-    surface_triangles: Option<PyReadonlyArray2<'py, i64>>,
+    surface_triangles: Option<Ints2<'py>>,
     shell_labels: Option<Vec<u32>>,
-    side_labels: Option<PyReadonlyArray2<'py, i64>>,
+    side_labels: Option<Ints2<'py>>,
     threads: Option<usize>,
 ) -> PyResult<String> {
     let mesh = mesh_from(&points, &tets, &labels)?;
@@ -356,8 +637,8 @@ fn check<'py>(
 fn quality<'py>(
     py: Python<'py>,
     points: PyReadonlyArray2<'py, f64>,
-    tets: PyReadonlyArray2<'py, i64>,
-    labels: PyReadonlyArray1<'py, i64>,
+    tets: Ints2<'py>,
+    labels: Ints1<'py>,
     threads: Option<usize>,
 ) -> PyResult<String> {
     let mesh = mesh_from(&points, &tets, &labels)?;
@@ -391,10 +672,10 @@ fn delaunay<'py>(
 fn recover_surface<'py>(
     py: Python<'py>,
     points: PyReadonlyArray2<'py, f64>,
-    tets: PyReadonlyArray2<'py, i64>,
-    labels: PyReadonlyArray1<'py, i64>,
+    tets: Ints2<'py>,
+    labels: Ints1<'py>,
     surface_points: PyReadonlyArray2<'py, f64>,
-    surface_triangles: PyReadonlyArray2<'py, i64>,
+    surface_triangles: Ints2<'py>,
     steiner: bool,
     keep_outside: bool,
     threads: Option<usize>,
@@ -431,28 +712,34 @@ fn recover_surface<'py>(
     Ok(mesh_out(py, mesh, report))
 }
 
-/// Sliver removal (LAST RESORT) in place of a tet mesh's poor tets.
+/// Sliver removal (LAST RESORT) in place of a tet mesh's poor tets: those under `threshold`
+/// (default 10° for the dihedral angle, 0.2 for q, as `biotet improve`).
 #[pyfunction]
-#[pyo3(signature = (points, tets, labels, threshold=10.0, metric="dihedral", threads=None))]
+#[pyo3(signature = (points, tets, labels, threshold=None, metric="dihedral", threads=None))]
 #[allow(clippy::too_many_arguments)]
 fn improve_mesh<'py>(
     py: Python<'py>,
     points: PyReadonlyArray2<'py, f64>,
-    tets: PyReadonlyArray2<'py, i64>,
-    labels: PyReadonlyArray1<'py, i64>,
-    threshold: f64,
+    tets: Ints2<'py>,
+    labels: Ints1<'py>,
+    threshold: Option<f64>,
     metric: &str,
     threads: Option<usize>,
 ) -> PyResult<MeshOut<'py>> {
-    let metric = match metric {
-        "dihedral" => Metric::Dihedral,
-        "q" => Metric::Q,
+    let (metric, threshold) = match metric {
+        "dihedral" => (Metric::Dihedral, threshold.unwrap_or(10.0)),
+        "q" => (Metric::Q, threshold.unwrap_or(0.2)),
         m => {
             return Err(pyo3::exceptions::PyValueError::new_err(format!(
                 "metric must be 'dihedral' or 'q', not {m:?}"
             )));
         }
     };
+    if !threshold.is_finite() || threshold <= 0.0 {
+        return Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "threshold {threshold}: expected a positive number"
+        )));
+    }
     let mut mesh = mesh_from(&points, &tets, &labels)?;
     let (mesh, report) = guarded(py, threads, move || {
         let opts = ImproveOptions {
@@ -469,19 +756,25 @@ fn improve_mesh<'py>(
 /// Solid-angle smoothing of a tet mesh (surface fixed, or sliding on the given surface).
 #[pyfunction]
 #[pyo3(signature = (points, tets, labels, surface_points=None, surface_triangles=None,
-    slide=false, max_sweeps=None, threads=None))]
+    slide=false, max_sweeps=None, feature_angle=45.0, threads=None))]
 #[allow(clippy::too_many_arguments)]
 fn smooth_mesh<'py>(
     py: Python<'py>,
     points: PyReadonlyArray2<'py, f64>,
-    tets: PyReadonlyArray2<'py, i64>,
-    labels: PyReadonlyArray1<'py, i64>,
+    tets: Ints2<'py>,
+    labels: Ints1<'py>,
     surface_points: Option<PyReadonlyArray2<'py, f64>>,
-    surface_triangles: Option<PyReadonlyArray2<'py, i64>>,
+    surface_triangles: Option<Ints2<'py>>,
     slide: bool,
     max_sweeps: Option<usize>,
+    feature_angle: f64,
     threads: Option<usize>,
 ) -> PyResult<MeshOut<'py>> {
+    if !(0.0..=180.0).contains(&feature_angle) {
+        return Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "feature_angle {feature_angle}: expected degrees between 0 and 180"
+        )));
+    }
     let mut mesh = mesh_from(&points, &tets, &labels)?;
     let surface = match (&surface_points, &surface_triangles) {
         (Some(p), Some(t)) => Some(surface_from(p, t, None, None, "surface".into())?),
@@ -495,6 +788,7 @@ fn smooth_mesh<'py>(
             } else {
                 Boundary::Fixed
             },
+            feature_angle_deg: feature_angle,
             ..SmoothOptions::default()
         };
         if let Some(n) = max_sweeps {
@@ -538,8 +832,8 @@ fn write_tet_mesh<'py>(
     py: Python<'py>,
     path: PathBuf,
     points: PyReadonlyArray2<'py, f64>,
-    tets: PyReadonlyArray2<'py, i64>,
-    labels: PyReadonlyArray1<'py, i64>,
+    tets: Ints2<'py>,
+    labels: Ints1<'py>,
 ) -> PyResult<Vec<PathBuf>> {
     let mesh = mesh_from(&points, &tets, &labels)?;
     guarded(py, None, move || {
@@ -554,6 +848,9 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_function(wrap_pyfunction!(mesh_arrays, m)?)?;
     m.add_function(wrap_pyfunction!(mesh_files, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh_image, m)?)?;
+    m.add_function(wrap_pyfunction!(surface_image, m)?)?;
+    m.add_function(wrap_pyfunction!(surface_image_file, m)?)?;
     m.add_function(wrap_pyfunction!(check, m)?)?;
     m.add_function(wrap_pyfunction!(quality, m)?)?;
     m.add_function(wrap_pyfunction!(delaunay, m)?)?;

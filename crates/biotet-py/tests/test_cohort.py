@@ -1,4 +1,5 @@
-"""The Dask cohort example on three small subjects (one invalid) with a 2-process LocalCluster."""
+"""The Dask cohort example on three small subjects (a surface, a label image, an invalid
+surface) with a 2-process LocalCluster."""
 
 import csv
 import subprocess
@@ -7,13 +8,13 @@ import sys
 import pytest
 
 import biotet
-from conftest import ROOT, SHAPES
+from conftest import IMAGES, ROOT, SHAPES
 
 pytest.importorskip("dask.distributed")
 
 
 def test_cohort_example_meshes_each_subject_and_reports_failures(tmp_path):
-    inputs = [SHAPES / "tm_box.off", SHAPES / "tm_torus.off", SHAPES / "invalid_open_box.off"]
+    inputs = [SHAPES / "tm_box.off", IMAGES / "label_uint8.mha", SHAPES / "invalid_open_box.off"]
     out = tmp_path / "out"
     r = subprocess.run(
         [sys.executable, str(ROOT / "examples" / "cohort_dask.py"), *map(str, inputs),
@@ -24,14 +25,20 @@ def test_cohort_example_meshes_each_subject_and_reports_failures(tmp_path):
     assert r.returncode == 1, r.stderr
     assert "2 of 3 subjects meshed" in r.stdout
     rows = {row["subject"]: row for row in csv.DictReader(open(out / "summary.csv"))}
-    assert set(rows) == {"tm_box", "tm_torus", "invalid_open_box"}
+    assert set(rows) == {"tm_box", "label_uint8", "invalid_open_box"}
     assert rows["invalid_open_box"]["status"] == "failed"
     assert "closed" in rows["invalid_open_box"]["error"]
-    for name in ("tm_box", "tm_torus"):
+    for name in ("tm_box", "label_uint8"):
         row = rows[name]
         assert row["status"] == "ok"
         m = biotet.read(out / f"{name}.vtu")
         assert m.n_tets == int(row["tets"])
-        assert biotet.check(m, biotet.read_surface(SHAPES / f"{name}.off"))["valid"]
+        assert biotet.check(m)["valid"]
         assert (out / f"{name}.json").is_file()
+    assert biotet.check(biotet.read(out / "tm_box.vtu"), biotet.read_surface(SHAPES / "tm_box.off"))["valid"]
+    # The image's regions keep its labels and their voxel volumes.
+    image = biotet.read(out / "label_uint8.vtu")
+    assert set(image.labels.tolist()) == {1, 2, 17, 41}
+    assert float(rows["label_uint8"]["max_region_volume_error"]) < 1e-9
+    assert rows["tm_box"]["max_region_volume_error"] == ""
     assert not (out / "invalid_open_box.vtu").exists()

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import biotet
-from conftest import SHAPES, cube
+from conftest import SHAPES, cube, run_cli
 
 
 def test_open_surface_is_invalid_naming_triangles():
@@ -96,3 +96,40 @@ def test_write_nothing_on_a_failed_write(tmp_path):
     with pytest.raises(biotet.BiotetFileError):
         m.write(tmp_path / "out.unknown")
     assert not any(tmp_path.iterdir())
+
+
+def bad_cubes():
+    """The CLI's bad surfaces (a hole, a flipped triangle, a crossing cube) and a degenerate
+    triangle, as (points, triangles)."""
+    p, t = cube()
+    q, u = cube((0.5, 0.25, 0.25), 0.5)
+    q = q * [2.0, 1.0, 1.0] - [0.5, 0, 0]
+    return {
+        "closed": (p, t[:-1]),
+        "orient": (p, np.vstack([t[:3], t[3:4, [0, 2, 1]], t[4:]])),
+        "intersect": (np.vstack([p, q]), np.vstack([t, u + 8])),
+        "degenerate": (np.vstack([p, p[0] * 0.5 + p[1] * 0.5]),
+                       np.vstack([t[:4], [[0, 8, 1]], t[4:]])),
+    }
+
+
+@pytest.mark.parametrize("case", ["closed", "orient", "intersect", "degenerate"])
+def test_invalid_surfaces_raise_the_cli_message(cli, tmp_path, case):
+    p, t = bad_cubes()[case]
+    path = tmp_path / f"{case}.off"
+    path.write_text(
+        f"OFF\n{len(p)} {len(t)} 0\n"
+        + "".join(" ".join(repr(float(x)) for x in q) + "\n" for q in p)
+        + "".join(f"3 {a} {b} {c}\n" for a, b, c in t)
+    )
+    r = run_cli(cli, "mesh", path, "--quiet")
+    assert r.returncode != 0, r.stderr
+    want = r.stderr.strip().removeprefix("error: ")
+    with pytest.raises(biotet.InvalidSurfaceError) as e:
+        biotet.mesh_file(path)
+    assert str(e.value) == want
+    if case != "degenerate":  # refused while assembling the shells: no triangle named
+        assert e.value.triangles and max(e.value.triangles) < len(t)
+    with pytest.raises(biotet.InvalidSurfaceError) as e2:
+        biotet.mesh(p, t, name=str(path))
+    assert str(e2.value) == want and e2.value.triangles == e.value.triangles

@@ -143,3 +143,21 @@ def test_surface_tolerance_moves_the_surface_within_the_bound(brain):
     assert s["hausdorff_in_to_out"] <= 0.5 and s["hausdorff_out_to_in"] <= 0.5
     assert m.report["quality"]["n_dihedral_lt_10"] < 100
     assert biotet.check(m)["valid"]
+
+
+def test_surface_stage_options_write_the_cli_bytes(cli, tmp_path):
+    src = SHAPES / "tm_torus.off"
+    s = biotet.read_surface(src)
+    d = 0.01 * float(np.linalg.norm(np.ptp(s.points, axis=0)))
+    out = tmp_path / "cli.vtu"
+    r = run_cli(cli, "mesh", src, "-o", out, "--quiet", "--surface-tolerance", repr(d),
+                "--feature-angle", "20", "--surface-rounds", "3")
+    assert r.returncode == 0, r.stderr
+    m = biotet.mesh_file(src, surface_tolerance=d, surface_feature_angle=20.0, surface_rounds=3)
+    mine = tmp_path / "py.vtu"
+    m.write(mine)
+    assert mine.read_bytes() == out.read_bytes()
+    assert m.report["surface"]["hausdorff_in_to_out"] <= d
+    # The options reach the stage: its default rounds give another surface.
+    other = biotet.mesh_file(src, surface_tolerance=d, surface_feature_angle=20.0)
+    assert other.points.shape != m.points.shape or not np.array_equal(other.points, m.points)

@@ -1,36 +1,39 @@
-"""The GIL is released while biotet computes: a Python thread keeps running."""
+"""The GIL is released while biotet computes: another Python thread runs meanwhile."""
 
+import sys
 import threading
+import time
 
 import biotet
 from conftest import DATA
 
 
 def test_a_python_thread_runs_while_meshing():
+    """With the switch interval made huge, a thread holding the GIL keeps it until it blocks:
+    had biotet held the GIL through the call, this (main) thread could not wake up before the
+    meshing thread ended, and would count nothing while it runs. No timing threshold: one
+    iteration while the meshing runs shows the release."""
     s = biotet.read_surface(DATA / "brain_20k.stl")
-    done = threading.Event()
-    ticks = []
-
-    def count():
-        while not done.is_set():
-            ticks.append(1)
+    started, done = threading.Event(), threading.Event()
 
     def mesh():
         try:
-            biotet.mesh(s.points, s.triangles, threads=1)
+            biotet.mesh(s.points, s.triangles, threads=1, progress=lambda stage: started.set())
         finally:
+            started.set()
             done.set()
 
-    counter = threading.Thread(target=count)
-    worker = threading.Thread(target=mesh)
-    # Start the mesher first and count only while it runs: with the GIL held for the whole run
-    # the counter would get (almost) no turns; switches every 5 ms would still give it some,
-    # so compare with the loop's own speed over the same run.
-    worker.start()
-    counter.start()
-    worker.join()
-    counter.join()
-    during = len(ticks)
-    # A held GIL lets the counter run only at the interpreter's switch interval (5 ms), a few
-    # hundred iterations per switch at most; released, it spins freely: millions.
-    assert during > 100_000, during
+    interval = sys.getswitchinterval()
+    sys.setswitchinterval(1000.0)
+    try:
+        worker = threading.Thread(target=mesh)
+        worker.start()
+        started.wait()
+        ticks = 0
+        while not done.is_set():
+            ticks += 1
+            time.sleep(0)  # releases the GIL, so the meshing thread's progress calls get it
+        worker.join()
+    finally:
+        sys.setswitchinterval(interval)
+    assert ticks > 0

@@ -41,6 +41,33 @@ pub enum SizeSpec {
     },
 }
 
+impl SizeSpec {
+    /// A [`SizeSpec::Field`] interpolated trilinearly from a grid (clamped to the grid outside
+    /// it), refused unless every value is positive. `frame_to_world` maps the points the mesher
+    /// asks about to the grid's coordinates: set for an oblique label image meshed in its
+    /// axis-aligned frame ([`crate::image::LabelImage::to_frame`]), where the grid is in world.
+    pub fn from_grid(
+        grid: crate::sizing_grid::ScalarGrid,
+        frame_to_world: Option<[[f64; 4]; 4]>,
+    ) -> Result<SizeSpec, SizingError> {
+        let (min, max) = (grid.min_value(), grid.max_value());
+        if min.is_nan() || min <= 0.0 {
+            return Err(SizingError::FieldNotPositive { min });
+        }
+        Ok(SizeSpec::Field {
+            size: Box::new(move |p| {
+                let mut q = [p];
+                if let Some(m) = &frame_to_world {
+                    crate::image::map_points(m, &mut q);
+                }
+                grid.value_at(q[0])
+            }),
+            min,
+            max,
+        })
+    }
+}
+
 impl std::fmt::Debug for SizeSpec {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
@@ -97,6 +124,12 @@ pub enum SizingError {
         min: f64,
         /// The maximum.
         max: f64,
+    },
+    /// A size field whose smallest value is not positive.
+    #[error("the size field's smallest value is {min}; sizes must be positive")]
+    FieldNotPositive {
+        /// Its smallest value.
+        min: f64,
     },
     /// Sizing from a surface that has no edges.
     #[error("the surface has no triangles to take sizes from")]

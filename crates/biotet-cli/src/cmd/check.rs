@@ -5,8 +5,15 @@ use anyhow::Result;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+/// Examples at the end of `biotet check --help`.
+const EXAMPLES: &str = "\
+Examples:
+  biotet check brain.vtu --surface brain.stl
+  biotet check head.vtu -s scalp.stl -s skull.stl -s brain.stl --json";
+
 /// Arguments of `biotet check`.
 #[derive(clap::Args)]
+#[command(after_help = EXAMPLES)]
 pub struct Args {
     /// The tet mesh: .vtu, .mesh, .msh, or TetGen .node/.ele.
     mesh: PathBuf,

@@ -9,8 +9,15 @@ use serde_json::json;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+/// Examples at the end of `biotet convert --help`.
+const EXAMPLES: &str = "\
+Examples:
+  biotet convert brain.vtu -o brain.msh
+  biotet convert head.stl --regions -o head_labelled.vtu";
+
 /// Arguments of `biotet convert`.
 #[derive(clap::Args)]
+#[command(after_help = EXAMPLES)]
 pub struct Args {
     /// Input mesh; its format is chosen by extension.
     input: PathBuf,

@@ -8,8 +8,15 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
+/// Examples at the end of `biotet delaunay --help`.
+const EXAMPLES: &str = "\
+Examples:
+  biotet delaunay points.xyz -o points.vtu
+  biotet delaunay points.node --json        (counts and times only, no file)";
+
 /// Arguments of `biotet delaunay`.
 #[derive(clap::Args)]
+#[command(after_help = EXAMPLES)]
 pub struct Args {
     /// The points: a TetGen .node file, or text with one `x y z` point per line (`#` comments).
     points: PathBuf,

@@ -17,8 +17,15 @@ enum MetricArg {
     Q,
 }
 
+/// Examples at the end of `biotet improve --help`.
+const EXAMPLES: &str = "\
+Examples:
+  biotet improve tetgen_brain.vtu --surface brain.stl -o brain_improved.vtu
+  biotet improve brain.vtu --threshold 15 -o brain_15.vtu --json";
+
 /// Arguments of `biotet improve`.
 #[derive(clap::Args)]
+#[command(after_help = EXAMPLES)]
 pub struct Args {
     /// The tet mesh: .vtu, .mesh, .msh, or TetGen .node/.ele.
     mesh: PathBuf,

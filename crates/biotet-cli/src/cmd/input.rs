@@ -2,7 +2,7 @@
 
 use crate::Common;
 use crate::progress::Stage;
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use biotet::mesh::shells::{Part, Shell, assemble};
 use biotet::mesh::side_labels::{self, FROM_GEOMETRY};
 use biotet::mesh::validate::{
@@ -264,4 +264,17 @@ pub fn surfaces(paths: &[PathBuf], common: Common, stage: &Stage) -> Result<Opti
         return Ok(None);
     }
     Ok(Some(labelled_surface(paths, &[], common, stage)?.0))
+}
+
+/// The `n` comma-separated finite numbers of option `--what`'s value `text`.
+pub fn numbers(what: &str, text: &str, n: usize) -> Result<Vec<f64>> {
+    let v: Vec<f64> = text
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .with_context(|| format!("--{what} {text}: expected {n} numbers separated by commas"))?;
+    if v.len() != n || v.iter().any(|x| !x.is_finite()) {
+        bail!("--{what} {text}: expected {n} finite numbers separated by commas");
+    }
+    Ok(v)
 }

@@ -2,7 +2,7 @@
 
 use crate::memory::{StagePeaks, map_mesh_sized_blocks, release_free_memory};
 use crate::{Common, output, plot, progress::Stage};
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use biotet::mesh::shells::Part;
 use biotet::pipeline::{PipelineOptions, mesh_surface};
 use biotet::quality::{QualityReport, forced};
@@ -47,7 +47,7 @@ pub struct Args {
     /// region; a point belongs to the innermost shell around it. Shells are labelled 1, 2, … in
     /// order of files and of shells within a file, unless --label says otherwise. Without a
     /// surface, the bundled brain example is meshed. A 2D planar straight-line graph (.poly,
-    /// .node/.edge, or a Dimension 2 .mesh with Edges) is meshed in 2D (see README "2D meshes").
+    /// .node/.edge, or a Dimension 2 .mesh with Edges) is meshed in 2D (see docs/commands.md, "2D meshes").
     surfaces: Vec<PathBuf>,
     /// Labels of one file's shells in order, as FILE=N[,N...] (repeatable); 0 makes a shell a
     /// cavity (not meshed).
@@ -91,7 +91,7 @@ pub struct Args {
     /// Template voxels per smallest edge length (eq. 2.1).
     #[arg(long, value_name = "R", default_value_t = 2.0)]
     resolution: f64,
-    /// Shape of the buffer zone around each node (Euclidean measured better; see README).
+    /// Shape of the buffer zone around each node (Euclidean measured better; see docs/commands.md).
     #[arg(long, value_enum, default_value = "euclidean")]
     zone: ZoneArg,
     /// Largest template size in voxels (one byte each).
@@ -241,26 +241,9 @@ pub fn run(a: Args) -> Result<ExitCode> {
         (Some(h), _) => SizeSpec::Uniform(h),
         (None, Some(path)) => {
             let grid = biotet_io::read_scalar_grid_named(path, a.size_field_array.as_deref())?;
-            let (min, max) = (grid.min_value(), grid.max_value());
-            if min.is_nan() || min <= 0.0 {
-                bail!(
-                    "{}: the size field's smallest value is {min}; sizes must be positive",
-                    path.display()
-                );
-            }
-            // An oblique image is meshed in its frame: look the field up in world.
+            // An oblique image is meshed in its frame: the field is looked up in world.
             let to_world = image.as_ref().and_then(|i| i.frame_to_world);
-            SizeSpec::Field {
-                size: Box::new(move |p| {
-                    let mut q = [p];
-                    if let Some(m) = &to_world {
-                        biotet::image::map_points(m, &mut q);
-                    }
-                    grid.value_at(q[0])
-                }),
-                min,
-                max,
-            }
+            SizeSpec::from_grid(grid, to_world).with_context(|| path.display().to_string())?
         }
         (None, None) => SizeSpec::FromSurface { grading: a.grading },
     };

@@ -14,3 +14,4 @@ pub mod remesh;
 pub mod smooth;
 pub mod surface;
 pub mod validate;
+pub mod view;

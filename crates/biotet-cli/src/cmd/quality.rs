@@ -8,8 +8,15 @@ use serde_json::json;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+/// Examples at the end of `biotet quality --help`.
+const EXAMPLES: &str = "\
+Examples:
+  biotet quality brain.vtu --surface brain.stl --svg brain_quality.svg
+  biotet quality brain.vtu --json > brain_quality.json";
+
 /// Arguments of `biotet quality`.
 #[derive(clap::Args)]
+#[command(after_help = EXAMPLES)]
 pub struct Args {
     /// The mesh: .vtu, .mesh, .msh, or TetGen .node/.ele (tets or 2D triangles).
     mesh: PathBuf,

@@ -1,6 +1,7 @@
 //! `biotet remesh`: replace one region, or the tets meeting a box or a sphere, at a new size;
 //! every other tet stays exactly as it was (see `biotet::remesh`).
 
+use super::input::numbers;
 use crate::{Common, progress::Stage};
 use anyhow::{Context, Result, bail};
 use biotet::TetMesh;
@@ -52,18 +53,6 @@ pub struct Args {
     grading: f64,
     #[command(flatten)]
     common: Common,
-}
-
-fn numbers(what: &str, text: &str, n: usize) -> Result<Vec<f64>> {
-    let v: Vec<f64> = text
-        .split(',')
-        .map(|x| x.trim().parse::<f64>())
-        .collect::<Result<_, _>>()
-        .with_context(|| format!("--{what} {text}: expected {n} numbers separated by commas"))?;
-    if v.len() != n || v.iter().any(|x| !x.is_finite()) {
-        bail!("--{what} {text}: expected {n} finite numbers separated by commas");
-    }
-    Ok(v)
 }
 
 fn zone(a: &Args) -> Result<Zone> {

@@ -18,8 +18,15 @@ enum BoundaryArg {
     Slide,
 }
 
+/// Examples at the end of `biotet smooth --help`.
+const EXAMPLES: &str = "\
+Examples:
+  biotet smooth brain.vtu --surface brain.stl -o brain_smooth.vtu --svg smooth.svg
+  biotet smooth tetgen.vtu --boundary slide --surface brain.stl -o smooth.vtu";
+
 /// Arguments of `biotet smooth`.
 #[derive(clap::Args)]
+#[command(after_help = EXAMPLES)]
 pub struct Args {
     /// The tet mesh: .vtu, .mesh, .msh, or TetGen .node/.ele.
     mesh: PathBuf,

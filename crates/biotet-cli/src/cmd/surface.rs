@@ -18,14 +18,24 @@ Examples:
   biotet mesh brain.stl --surface-tolerance 0.5 -o brain.vtu
       The same stage, then the usual pipeline with the improved surface kept exactly.";
 
+/// Examples at the end of `biotet surface --help`.
+const SURFACE_EXAMPLES: &str = "\
+Examples:
+  biotet surface tests/data/mni_head.nii.gz -o head_surface.vtu
+  biotet surface improve brain.stl --tolerance 0.5 -o brain_improved.ply";
+
 /// Arguments of `biotet surface`.
 #[derive(clap::Args)]
-#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
+#[command(
+    args_conflicts_with_subcommands = true,
+    subcommand_negates_reqs = true,
+    after_help = SURFACE_EXAMPLES
+)]
 pub struct Args {
     #[command(subcommand)]
     command: Option<Sub>,
     /// Label image: .nii, .nii.gz, .mgh, .mgz, .nrrd, .nhdr, .mha, .mhd, .vti (world
-    /// coordinates RAS+, see README); its labelled surface is written, as `surface extract`.
+    /// coordinates RAS+, see docs/formats.md); its labelled surface is written, as `surface extract`.
     #[arg(required = true)]
     image: Option<PathBuf>,
     /// Output labelled surface (.vtu, .ply or .mesh keep the labels on both sides of each

@@ -6,8 +6,15 @@ use serde_json::json;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+/// Examples at the end of `biotet validate --help`.
+const EXAMPLES: &str = "\
+Examples:
+  biotet validate brain.stl
+  biotet validate scalp.stl skull.stl brain.stl --json";
+
 /// Arguments of `biotet validate`.
 #[derive(clap::Args)]
+#[command(after_help = EXAMPLES)]
 pub struct Args {
     /// Surfaces: .stl .obj .off .ply .mesh.
     #[arg(required = true)]

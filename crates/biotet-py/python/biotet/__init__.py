@@ -1,19 +1,22 @@
-"""biotet: tetrahedral meshes of anatomy from closed triangulated surfaces.
+"""biotet: tetrahedral meshes of anatomy from closed triangulated surfaces and label images.
 
-Every input triangle is kept exactly, interior nodes are deployed on a template, boundary
-recovery and sliver removal use the LAST RESORT search, and solid-angle smoothing finishes the
-mesh. numpy arrays go in and out; the GIL is released while biotet computes, so threads and Dask
-workers mesh in parallel.
+Every input triangle is kept exactly (a label volume becomes such a surface, two triangles per
+voxel face between labels), interior nodes are deployed on a template, boundary recovery and
+sliver removal use the LAST RESORT search, and solid-angle smoothing finishes the mesh. numpy
+arrays go in and out; the GIL is released while biotet computes, so threads and Dask workers
+mesh in parallel.
 
 >>> import biotet, numpy as np
 >>> m = biotet.mesh_file("brain.stl")                    # doctest: +SKIP
 >>> m.points.shape, m.tets.shape, m.report["quality"]["min_dihedral_deg"]  # doctest: +SKIP
+>>> seg = biotet.mesh_image(labels, affine=img.affine)   # doctest: +SKIP
 
-Functions mirror the command-line tool: :func:`mesh`, :func:`mesh_file`, :func:`recover`,
-:func:`improve`, :func:`smooth`, :func:`check`, :func:`quality`, :func:`delaunay`,
-:func:`read`, :func:`write`. Errors are :class:`InvalidSurfaceError` (a ``ValueError``),
-:class:`MeshingError`, and ``OSError`` subclasses for files. Progress goes to the ``biotet``
-logger (level INFO) or to a ``progress`` callable.
+Functions mirror the command-line tool: :func:`mesh`, :func:`mesh_image`, :func:`mesh_file`,
+:func:`surface_extract`, :func:`recover`, :func:`improve`, :func:`smooth`, :func:`check`,
+:func:`quality`, :func:`delaunay`, :func:`read`, :func:`write`. Errors are
+:class:`InvalidSurfaceError` (a ``ValueError``), :class:`MeshingError`, ``ValueError`` for bad
+arguments, and ``OSError`` subclasses for files, with the CLI's messages. Progress goes to the
+``biotet`` logger (level INFO) or to a ``progress`` callable; nothing is printed.
 """
 
 from __future__ import annotations
@@ -31,12 +34,15 @@ from . import _core
 __all__ = [
     "TetMesh",
     "Surface",
+    "SizeField",
     "BiotetError",
     "InvalidSurfaceError",
     "MeshingError",
     "BiotetFileError",
     "mesh",
+    "mesh_image",
     "mesh_file",
+    "surface_extract",
     "recover",
     "improve",
     "smooth",
@@ -117,24 +123,36 @@ def _progress(progress: Callable[[str], Any] | None) -> Callable[[str], Any] | N
 
 
 def _points(a: Any, what: str = "points") -> np.ndarray:
-    p = np.ascontiguousarray(a, dtype=np.float64)
+    """Points as float64 (n, 3), passed to biotet in place when they are float64 already."""
+    p = np.asarray(a, dtype=np.float64)
     if p.ndim != 2 or p.shape[1] != 3:
         raise ValueError(f"{what} must have shape (n, 3), not {p.shape}")
     return p
 
 
+_INDEX_TYPES = (np.dtype(np.int32), np.dtype(np.int64))
+
+
 def _indices(a: Any, width: int, what: str) -> np.ndarray:
+    """Index rows as int32 or int64 (n, width), passed in place when they are either (biotet
+    returns int32); other integer types are converted once."""
     x = np.asarray(a)
     if x.size and not np.issubdtype(x.dtype, np.integer):
         raise ValueError(f"{what} must hold integers, not {x.dtype}")
-    x = np.ascontiguousarray(x, dtype=np.int64)
+    if x.dtype not in _INDEX_TYPES:
+        x = x.astype(np.int64)
     if x.ndim != 2 or x.shape[1] != width:
         raise ValueError(f"{what} must have shape (n, {width}), not {x.shape}")
     return x
 
 
 def _labels(a: Any, n: int) -> np.ndarray:
-    x = np.ascontiguousarray(a, dtype=np.int64).reshape(-1)
+    """Labels as int32 or int64 (n,), passed in place when they are either."""
+    x = np.asarray(a).reshape(-1)
+    if x.size and not np.issubdtype(x.dtype, np.integer):
+        raise ValueError(f"labels must hold integers, not {x.dtype}")
+    if x.dtype not in _INDEX_TYPES:
+        x = x.astype(np.int64)
     if x.shape[0] != n:
         raise ValueError(f"labels has {x.shape[0]} entries for {n} tets")
     return x
@@ -229,8 +247,11 @@ def _mesh_options(
     steiner: bool,
     stages: tuple[bool, bool, bool, bool],
     surface_tolerance: float | None,
+    surface: tuple[float, int, bool],
+    size_field: dict | None,
 ) -> dict:
-    """The options of ``mesh`` and ``mesh_file`` as the native module reads them."""
+    """The options of ``mesh``, ``mesh_image`` and ``mesh_file`` as the native module reads
+    them."""
     return dict(
         size=size,
         grading=grading,
@@ -243,7 +264,120 @@ def _mesh_options(
         steiner=steiner,
         stages=stages,
         surface_tolerance=surface_tolerance,
+        surface_feature_angle=float(surface[0]),
+        surface_rounds=int(surface[1]),
+        adaptive_size=bool(surface[2]),
+        size_field=size_field,
     )
+
+
+@dataclass
+class SizeField:
+    """A desired edge length sampled on a regular grid, as the CLI's ``--size-field`` reads
+    from a .vti or NIfTI file: ``values[i, j, k]`` (positive) is the size at the grid point
+    ``affine @ (i, j, k, 1)``, or at ``origin + spacing * (i, j, k)`` without an affine (the
+    convention of :func:`mesh_image`). Interpolated trilinearly, clamped to the grid outside
+    it."""
+
+    values: Any
+    spacing: Sequence[float] = (1.0, 1.0, 1.0)
+    origin: Sequence[float] = (0.0, 0.0, 0.0)
+    affine: Any = None
+
+
+def _affine(spacing: Sequence[float], origin: Sequence[float], affine: Any,
+            what: str) -> list[list[float]]:
+    """A 4×4 voxel-to-world matrix from an affine (4×4, or its first 3 rows) or from a spacing
+    and an origin."""
+    if affine is not None:
+        m = np.asarray(affine, dtype=np.float64)
+        if m.shape == (3, 4):
+            m = np.vstack([m, [0.0, 0.0, 0.0, 1.0]])
+        if m.shape != (4, 4):
+            raise ValueError(f"{what}: affine must have shape (4, 4) or (3, 4), not {m.shape}")
+        if not np.array_equal(m[3], [0.0, 0.0, 0.0, 1.0]):
+            raise ValueError(f"{what}: the affine's last row must be (0, 0, 0, 1), not {m[3]}")
+        if tuple(map(float, spacing)) != (1.0, 1.0, 1.0) or tuple(map(float, origin)) != (
+            0.0, 0.0, 0.0
+        ):
+            raise ValueError(f"{what}: give an affine or a spacing and an origin, not both")
+        return m.tolist()
+    sp = np.asarray(spacing, dtype=np.float64).reshape(-1)
+    og = np.asarray(origin, dtype=np.float64).reshape(-1)
+    if sp.shape != (3,) or og.shape != (3,):
+        raise ValueError(f"{what}: spacing and origin must hold 3 numbers each")
+    m = np.eye(4)
+    m[:3, :3] = np.diag(sp)
+    m[:3, 3] = og
+    return m.tolist()
+
+
+def _size_field(size_field: Any, array: str | None,
+                image_affine: list[list[float]] | None = None) -> dict | None:
+    """The native module's form of ``size_field``: a path (with the .vti array name), a
+    :class:`SizeField`, or (for :func:`mesh_image`) an array on the image's own grid."""
+    if size_field is None:
+        if array is not None:
+            raise ValueError("size_field_array needs a size_field file")
+        return None
+    if isinstance(size_field, (str, os.PathLike)):
+        return dict(path=os.fspath(size_field), array=array, values=None, affine=None)
+    if array is not None:
+        raise ValueError("size_field_array names an array of a .vti size_field file")
+    if isinstance(size_field, SizeField):
+        affine = _affine(size_field.spacing, size_field.origin, size_field.affine, "size_field")
+        values = size_field.values
+    elif image_affine is not None:
+        affine, values = image_affine, size_field
+    else:
+        raise ValueError(
+            "size_field must be a file path or a biotet.SizeField(values, spacing, origin, "
+            "affine); a bare array is taken on the image's grid by mesh_image only"
+        )
+    v = np.asarray(values, dtype=np.float64)
+    if v.ndim != 3:
+        raise ValueError(f"size_field: values must be a 3-D array, not of shape {v.shape}")
+    return dict(path=None, array=None, values=v, affine=affine)
+
+
+def _image_options(keep_labels: Iterable[int] | None, merge: Mapping[int, int] | None,
+                   outside: int, min_component_voxels: int) -> dict:
+    """The label options of an image (``--labels``, ``--merge``, ``--outside``,
+    ``--min-component-voxels``) as the native module reads them."""
+    return dict(
+        keep=None if keep_labels is None else sorted({int(x) for x in keep_labels}),
+        merge=[([int(a)], int(b)) for a, b in sorted((merge or {}).items())],
+        outside=int(outside),
+        min_component_voxels=int(min_component_voxels),
+    )
+
+
+_LABEL_MAX = 2**32 - 1
+
+
+def _label_volume(labels: Any) -> np.ndarray:
+    """A label volume as uint32 (no copy when it is one already), refusing values that are no
+    labels (negative, fractional, too large) with the first such voxel, as the file readers
+    do."""
+    a = np.asarray(labels)
+    if a.ndim != 3:
+        raise ValueError(f"labels must be a 3-D array (i, j, k), not of shape {a.shape}")
+    if a.dtype == np.bool_ or a.dtype == np.uint32:
+        return np.asarray(a, dtype=np.uint32)
+    if np.issubdtype(a.dtype, np.integer):
+        bad = (a < 0) | (a > _LABEL_MAX)
+    elif np.issubdtype(a.dtype, np.floating):
+        with np.errstate(invalid="ignore"):
+            bad = ~np.isfinite(a) | (a != np.round(a)) | (a < 0) | (a > _LABEL_MAX)
+    else:
+        raise ValueError(f"labels must hold integers, not {a.dtype}")
+    if bad.any():
+        first = int(np.flatnonzero(bad.ravel(order="F"))[0])
+        ijk = tuple(int(x) for x in np.unravel_index(first, a.shape, order="F"))
+        raise ValueError(
+            f"labels: voxel {ijk} holds {a[ijk]}, not a label (an integer in 0..2**32)"
+        )
+    return np.asarray(a, dtype=np.uint32)
 
 
 def mesh(
@@ -253,6 +387,8 @@ def mesh(
     labels: Sequence[int] | None = None,
     side_labels: Any = None,
     size: float | None = None,
+    size_field: PathLike | SizeField | None = None,
+    size_field_array: str | None = None,
     grading: float = 0.3,
     min_size: float | None = None,
     max_size: float | None = None,
@@ -266,6 +402,9 @@ def mesh(
     smooth: bool = True,
     polish: bool = True,
     surface_tolerance: float | None = None,
+    surface_feature_angle: float = 30.0,
+    surface_rounds: int = 6,
+    adaptive_size: bool = False,
     threads: int | None = None,
     progress: Callable[[str], Any] | None = None,
     name: str = "arrays",
@@ -275,15 +414,23 @@ def mesh(
     ``vertices`` (n×3) and ``faces`` (m×3 indices) hold one or more closed shells; each encloses
     a region, innermost first, labelled ``labels`` (one per shell, in order of first triangle)
     or 1, 2, ... by nesting. Or give ``side_labels`` (m×2: the region behind and in front of
-    each triangle) for a multi-material surface. Sizes: ``size`` (uniform), else from the
-    surface's own edges growing by ``grading`` per unit distance, clamped to
-    ``min_size``/``max_size``; ``region_sizes`` maps a region label to its size. ``steiner=False``
-    forbids interior points added by recovery; ``recover``/``improve``/``smooth``/``polish``
-    switch stages off. ``surface_tolerance=D`` first remeshes the surface within a two-sided
-    Hausdorff distance D (``biotet mesh --surface-tolerance D``; reported in
-    ``report["surface"]``): fewer slivers, the surface no longer kept exactly. ``threads``: worker threads (default one per core; the result does not
-    depend on it). Raises :class:`InvalidSurfaceError` for an invalid surface and
-    :class:`MeshingError` if meshing cannot finish.
+    each triangle) for a multi-material surface.
+
+    Sizes: ``size`` (uniform), else ``size_field`` (a .vti or NIfTI file, with
+    ``size_field_array`` naming a .vti array, or a :class:`SizeField`; as ``--size-field``), else
+    from the surface's own edges growing by ``grading`` per unit distance; all clamped to
+    ``min_size``/``max_size``. ``region_sizes`` maps a region label to a uniform size inside it
+    (``--region-size``). ``steiner=False`` forbids interior points added by recovery
+    (``--no-steiner``); ``recover``/``improve``/``smooth``/``polish`` switch stages off.
+    ``surface_tolerance=D`` first remeshes the surface within a two-sided Hausdorff distance D
+    (``--surface-tolerance D``; reported in ``report["surface"]``): fewer slivers, the surface
+    no longer kept exactly; ``surface_feature_angle``, ``surface_rounds`` and ``adaptive_size``
+    are that stage's ``--feature-angle``, ``--surface-rounds`` and ``--adaptive-size``. ``threads``: worker threads (default one per core; the result does
+    not depend on it). ``progress``: called with each stage's name (default: the ``biotet``
+    logger at level INFO).
+
+    Raises :class:`InvalidSurfaceError` for an invalid surface, :class:`MeshingError` if
+    meshing cannot finish, ``ValueError`` for bad arguments.
     """
     v = _points(vertices, "vertices")
     f = _indices(faces, 3, "faces")
@@ -292,15 +439,25 @@ def mesh(
     o = _mesh_options(
         size, grading, min_size, max_size, region_sizes, resolution, zone, max_voxels,
         steiner, (recover, improve, smooth, polish), surface_tolerance,
+        (surface_feature_angle, surface_rounds, adaptive_size),
+        _size_field(size_field, size_field_array),
     )
     return _tet(_call(_core.mesh_arrays, v, f, shell, s, name, o, threads, _progress(progress)))
 
 
-def mesh_file(
-    paths: PathLike | Iterable[PathLike],
+def mesh_image(
+    labels: Any,
+    spacing: Sequence[float] = (1.0, 1.0, 1.0),
+    origin: Sequence[float] = (0.0, 0.0, 0.0),
+    affine: Any = None,
     *,
-    labels: Mapping[str, Sequence[int]] | None = None,
+    keep_labels: Iterable[int] | None = None,
+    merge: Mapping[int, int] | None = None,
+    outside: int = 0,
+    min_component_voxels: int = 0,
     size: float | None = None,
+    size_field: Any = None,
+    size_field_array: str | None = None,
     grading: float = 0.3,
     min_size: float | None = None,
     max_size: float | None = None,
@@ -314,13 +471,112 @@ def mesh_file(
     smooth: bool = True,
     polish: bool = True,
     surface_tolerance: float | None = None,
+    surface_feature_angle: float = 30.0,
+    surface_rounds: int = 6,
+    adaptive_size: bool = False,
+    threads: int | None = None,
+    progress: Callable[[str], Any] | None = None,
+    name: str = "image",
+) -> TetMesh:
+    """Mesh the regions of a label volume (a segmentation), as ``biotet mesh IMAGE`` does.
+
+    ``labels[i, j, k]`` (integers ≥ 0; integral floats are accepted) is the label of the voxel
+    centred at ``origin + spacing * (i, j, k)``, or at ``affine @ (i, j, k, 1)`` when an
+    ``affine`` (4×4 or 3×4, voxel to world, e.g. nibabel's ``img.affine``) is given. Each
+    non-zero value is a region whose tets keep that value as their label; 0 is the outside.
+    The surface is the voxel faces between labels, kept exactly (an oblique image is meshed in
+    its axis-aligned frame and rotated to world), so each region's mesh volume is its voxel
+    volume.
+
+    The label options, as the CLI's: ``keep_labels`` (``--labels``: the others become outside),
+    ``merge`` (``--merge``: a mapping from a label to the label it joins, applied first),
+    ``outside`` (``--outside``: the value of the outside), ``min_component_voxels``
+    (``--min-component-voxels``: smaller 6-connected islands join the label around them).
+
+    Sizes: ``size`` (uniform), else ``size_field`` (a .vti or NIfTI file, with
+    ``size_field_array`` naming a .vti array, or a :class:`SizeField`; as ``--size-field``), else
+    from the surface's own edges growing by ``grading`` per unit distance; all clamped to
+    ``min_size``/``max_size``. ``region_sizes`` maps a region label to a uniform size inside it
+    (``--region-size``). ``steiner=False`` forbids interior points added by recovery
+    (``--no-steiner``); ``recover``/``improve``/``smooth``/``polish`` switch stages off.
+    ``surface_tolerance=D`` first remeshes the surface within a two-sided Hausdorff distance D
+    (``--surface-tolerance D``; reported in ``report["surface"]``): fewer slivers, the surface
+    no longer kept exactly; ``surface_feature_angle``, ``surface_rounds`` and ``adaptive_size``
+    are that stage's ``--feature-angle``, ``--surface-rounds`` and ``--adaptive-size``. ``threads``: worker threads (default one per core; the result does
+    not depend on it). ``progress``: called with each stage's name (default: the ``biotet``
+    logger at level INFO). A bare array as ``size_field`` is taken on the image's own grid.
+
+    ``report["image"]`` says what the extraction did and ``report["image_regions"]`` compares
+    each region's mesh volume with its voxel volume. Raises ``ValueError`` for bad labels or
+    options (with the CLI's messages), :class:`MeshingError` if meshing cannot finish.
+    """
+    vol = _label_volume(labels)
+    m = _affine(spacing, origin, affine, "mesh_image")
+    img = _image_options(keep_labels, merge, outside, min_component_voxels)
+    o = _mesh_options(
+        size, grading, min_size, max_size, region_sizes, resolution, zone, max_voxels,
+        steiner, (recover, improve, smooth, polish), surface_tolerance,
+        (surface_feature_angle, surface_rounds, adaptive_size),
+        _size_field(size_field, size_field_array, m),
+    )
+    return _tet(_call(_core.mesh_image, vol, m, name, img, o, threads, _progress(progress)))
+
+
+def mesh_file(
+    paths: PathLike | Iterable[PathLike],
+    *,
+    labels: Mapping[str, Sequence[int]] | None = None,
+    keep_labels: Iterable[int] | None = None,
+    merge: Mapping[int, int] | None = None,
+    outside: int = 0,
+    min_component_voxels: int = 0,
+    size: float | None = None,
+    size_field: PathLike | SizeField | None = None,
+    size_field_array: str | None = None,
+    grading: float = 0.3,
+    min_size: float | None = None,
+    max_size: float | None = None,
+    region_sizes: Mapping[int, float] | None = None,
+    resolution: float = 2.0,
+    zone: str = "euclidean",
+    max_voxels: int = 1 << 31,
+    steiner: bool = True,
+    recover: bool = True,
+    improve: bool = True,
+    smooth: bool = True,
+    polish: bool = True,
+    surface_tolerance: float | None = None,
+    surface_feature_angle: float = 30.0,
+    surface_rounds: int = 6,
+    adaptive_size: bool = False,
     threads: int | None = None,
     progress: Callable[[str], Any] | None = None,
 ) -> TetMesh:
-    """Mesh the volume inside the closed surfaces in one or more files (STL, OBJ, OFF, PLY,
-    Medit .mesh, VTU), exactly as ``biotet mesh FILE...`` does: the same tets, byte for byte,
-    for the same options. ``labels`` maps a file (as given, or its name) to the labels of its
-    shells, as ``--label FILE=N,...``. Other options as in :func:`mesh`."""
+    """Mesh what files hold, exactly as ``biotet mesh FILE...`` does (the same tets, byte for
+    byte, for the same options): the volume inside the closed surfaces of one or more surface
+    files (STL, OBJ, OFF, PLY, Medit .mesh, VTU), or the regions of one label image (.nii,
+    .nii.gz, .mgh, .mgz, .nrrd, .nhdr, .mha, .mhd, .vti; world coordinates RAS+).
+
+    ``labels`` maps a surface file (as given, or its name) to the labels of its shells, as
+    ``--label FILE=N,...``. ``keep_labels``, ``merge``, ``outside`` and
+    ``min_component_voxels`` apply to a label image, as in :func:`mesh_image`.
+
+    Sizes: ``size`` (uniform), else ``size_field`` (a .vti or NIfTI file, with
+    ``size_field_array`` naming a .vti array, or a :class:`SizeField`; as ``--size-field``), else
+    from the surface's own edges growing by ``grading`` per unit distance; all clamped to
+    ``min_size``/``max_size``. ``region_sizes`` maps a region label to a uniform size inside it
+    (``--region-size``). ``steiner=False`` forbids interior points added by recovery
+    (``--no-steiner``); ``recover``/``improve``/``smooth``/``polish`` switch stages off.
+    ``surface_tolerance=D`` first remeshes the surface within a two-sided Hausdorff distance D
+    (``--surface-tolerance D``; reported in ``report["surface"]``): fewer slivers, the surface
+    no longer kept exactly; ``surface_feature_angle``, ``surface_rounds`` and ``adaptive_size``
+    are that stage's ``--feature-angle``, ``--surface-rounds`` and ``--adaptive-size``. ``threads``: worker threads (default one per core; the result does
+    not depend on it). ``progress``: called with each stage's name (default: the ``biotet``
+    logger at level INFO).
+
+    Raises ``FileNotFoundError``/:class:`BiotetFileError` (``OSError``) for unreadable files,
+    and otherwise as :func:`mesh` and :func:`mesh_image`.
+    """
     if isinstance(paths, (str, os.PathLike)):
         paths = [paths]
     ps = [os.fspath(p) for p in paths]
@@ -330,11 +586,45 @@ def mesh_file(
         if not hits:
             raise ValueError(f"labels: {key} is not one of the input files")
         per_file[hits[0]] = [int(x) for x in ls]
+    img = _image_options(keep_labels, merge, outside, min_component_voxels)
     o = _mesh_options(
         size, grading, min_size, max_size, region_sizes, resolution, zone, max_voxels,
         steiner, (recover, improve, smooth, polish), surface_tolerance,
+        (surface_feature_angle, surface_rounds, adaptive_size),
+        _size_field(size_field, size_field_array),
     )
-    return _tet(_call(_core.mesh_files, ps, per_file, o, threads, _progress(progress)))
+    return _tet(_call(_core.mesh_files, ps, per_file, img, o, threads, _progress(progress)))
+
+
+def surface_extract(
+    image: Any,
+    spacing: Sequence[float] = (1.0, 1.0, 1.0),
+    origin: Sequence[float] = (0.0, 0.0, 0.0),
+    affine: Any = None,
+    *,
+    keep_labels: Iterable[int] | None = None,
+    merge: Mapping[int, int] | None = None,
+    outside: int = 0,
+    min_component_voxels: int = 0,
+    name: str = "image",
+) -> Surface:
+    """The labelled surface of a label image, as ``biotet surface IMAGE -o OUT`` writes it: every
+    voxel face between two labels (after the label options, as in :func:`mesh_image`) as two
+    triangles whose ``sides`` are the labels behind and in front, each region closed and
+    manifold, in world coordinates. ``image`` is a label image file or a numpy label volume
+    with its ``spacing``/``origin`` or ``affine``. It is the surface :func:`mesh_image` and
+    :func:`mesh_file` keep exactly, so ``check(mesh, surface)`` verifies that a mesh of the
+    image conforms to it."""
+    img = _image_options(keep_labels, merge, outside, min_component_voxels)
+    if isinstance(image, (str, os.PathLike)):
+        if (tuple(map(float, spacing)) != (1.0, 1.0, 1.0)
+                or tuple(map(float, origin)) != (0.0, 0.0, 0.0) or affine is not None):
+            raise ValueError("surface_extract: a file holds its own geometry; give no "
+                             "spacing, origin or affine")
+        return Surface(*_call(_core.surface_image_file, os.fspath(image), img))
+    vol = _label_volume(image)
+    m = _affine(spacing, origin, affine, "surface_extract")
+    return Surface(*_call(_core.surface_image, vol, m, name, img))
 
 
 def _surface_arrays(surface: Surface | tuple[Any, Any] | None) -> tuple[Any, Any]:
@@ -397,23 +687,25 @@ def recover(mesh: TetMesh, surface: Surface | tuple[Any, Any], *, steiner: bool 
                       keep_outside=keep_outside, threads=threads))
 
 
-def improve(mesh: TetMesh, *, threshold: float = 10.0, metric: str = "dihedral",
+def improve(mesh: TetMesh, *, threshold: float | None = None, metric: str = "dihedral",
             threads: int | None = None) -> TetMesh:
-    """Remove slivers by refilling their cavities (LAST RESORT): tets whose smallest dihedral
-    angle (``metric="dihedral"``, degrees) or q (``metric="q"``) is under ``threshold``. Points
-    and surface are kept."""
+    """Remove slivers by refilling their cavities (LAST RESORT), as ``biotet improve``: tets
+    whose smallest dihedral angle (``metric="dihedral"``, degrees, default threshold 10) or q
+    (``metric="q"``, default threshold 0.2) is under ``threshold``. Points and surface are
+    kept."""
     return _tet(_call(_core.improve_mesh, *_mesh_arrays(mesh), threshold=threshold,
                       metric=metric, threads=threads))
 
 
 def smooth(mesh: TetMesh, surface: Surface | tuple[Any, Any] | None = None, *,
-           slide: bool = False, max_sweeps: int | None = None,
+           slide: bool = False, max_sweeps: int | None = None, feature_angle: float = 45.0,
            threads: int | None = None) -> TetMesh:
-    """Raise the smallest solid angles by moving nodes (the surface fixed, or sliding on
-    ``surface`` with ``slide=True``)."""
+    """Raise the smallest solid angles by moving nodes, as ``biotet smooth``: the surface and
+    interfaces fixed, or with ``slide=True`` sliding on ``surface`` (feature edges sharper than
+    ``feature_angle`` degrees, and corners, stay). ``max_sweeps`` defaults to 10."""
     sp, st = _surface_arrays(surface)
     return _tet(_call(_core.smooth_mesh, *_mesh_arrays(mesh), sp, st, slide=slide,
-                      max_sweeps=max_sweeps, threads=threads))
+                      max_sweeps=max_sweeps, feature_angle=feature_angle, threads=threads))
 
 
 _SURFACE_ONLY = (".stl", ".obj", ".off", ".ply")

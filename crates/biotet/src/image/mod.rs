@@ -10,9 +10,12 @@
 //!   components, small islands merged into their surroundings.
 //! - [`extract`]: the voxel-face surface of all label interfaces, one conforming labelled
 //!   [`crate::SurfaceMesh`], each region closed and manifold.
+//! - [`surface`]: both, on an image, with the summary the reports print (shared by the CLI and
+//!   the Python package).
 
 pub mod extract;
 pub mod labels;
+pub mod surface;
 
 /// Apply an affine map (the last row `[0, 0, 0, 1]`) to points in place.
 pub fn map_points(m: &[[f64; 4]; 4], points: &mut [[f64; 3]]) {

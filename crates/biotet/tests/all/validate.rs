@@ -621,7 +621,7 @@ fn brain_surface_is_valid() {
     assert_eq!(r.n_components, 1);
     assert_eq!(r.components[0].genus, Some(28));
     assert_eq!(r.regions[0].shells[0].genus, 28);
-    // The README gives 1,659,213 mm³.
+    // tests/data/README.md gives 1,659,213 mm³.
     assert!(
         (r.regions[0].volume - 1_659_213.0).abs() < 1.0,
         "{}",
