@@ -1,4 +1,4 @@
-//! Determinism across the whole CLI: every command gives byte-identical output files, and the
+//! Determinism across the whole CLI: every command (`view` included) gives byte-identical output files, and the
 //! same stdout less its times and memory figures, with `--threads` 1, 2 and 4 and on a second
 //! run with 2. Every tet mesh written is also checked.
 
@@ -225,4 +225,14 @@ fn every_command_is_deterministic() {
     deterministic("convert", &["convert", mesh, "-o", "{out}/c.msh"], base);
     deterministic("quality", &["quality", mesh, "--svg", "{out}/q.svg"], base);
     deterministic("check", &["check", mesh, "--surface", torus], base);
+    deterministic(
+        "view",
+        &["view", mesh, "--surface", torus, "-o", "{out}/v.svg"],
+        base,
+    );
+    deterministic(
+        "view_png",
+        &["view", mesh, "--view", "iso", "-o", "{out}/v.png"],
+        base,
+    );
 }

@@ -293,7 +293,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
     let estimate = crate::memory::estimate_mesh(&surface, &sizing, &opts.deploy);
     let limit = biotet_io::limits::max_memory();
     if estimate.bytes > limit as f64 {
-        bail!(
+        anyhow::bail!(
             "{name}: meshing needs about {} of memory (about {:.0} nodes, {:.0} template voxels), \
              more than the limit of {} (--max-memory); give a larger size or a larger limit",
             biotet_io::limits::human(estimate.bytes.min(u64::MAX as f64) as u64),
