@@ -26,6 +26,11 @@ struct Cli {
     /// sweeps, surface validation); 0 or absent: one per core. Results do not depend on it.
     #[arg(long, global = true, value_name = "N")]
     threads: Option<usize>,
+    /// Memory limit (bytes, or with a unit: 512M, 8G): images, grids and compressed data larger,
+    /// and meshing estimated larger, are refused before the work starts. Default: three
+    /// quarters of the machine's memory.
+    #[arg(long, global = true, value_name = "BYTES", value_parser = memory::parse_bytes)]
+    max_memory: Option<u64>,
 }
 
 /// Options every command takes.
@@ -113,6 +118,10 @@ fn main() -> ExitCode {
         eprintln!("error: --threads {n}: {e}");
         return ExitCode::from(EXIT_ERROR);
     }
+    biotet_io::limits::set_max_memory(
+        cli.max_memory
+            .unwrap_or_else(biotet_io::limits::default_max_memory),
+    );
     let json = std::env::args().any(|a| a == "--json");
     let result = match cli.command {
         Command::Quality(a) => cmd::quality::run(a),

@@ -6,7 +6,8 @@
 //! files (TetGen), every file is written to its temporary first and only then are all renamed,
 //! so an error while writing any of them leaves none behind. (The renames themselves are done one
 //! after the other; a failure between two renames — rare, as all temporaries are on the target
-//! file systems already — can leave a mix of old and new files.)
+//! file systems already — can leave a mix of old and new files.) A process killed before the
+//! rename leaves the previous file (or none) and a `.<name>.<random>.tmp` beside it.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -74,11 +75,24 @@ where
         tmp.as_file().sync_all().map_err(|e| Error::io(&name, e))?;
         temps.push(tmp);
     }
+    pause_before_rename();
     for (tmp, p) in temps.into_iter().zip(paths) {
         tmp.persist(p)
             .map_err(|e| Error::io(&p.display().to_string(), e.error))?;
     }
     Ok(())
+}
+
+/// The fault tests' hook: with `BIOTET_TEST_PAUSE_BEFORE_RENAME` naming a file, that file is
+/// created once every temporary is complete and synced, and the process waits there (for the
+/// test's SIGKILL) instead of renaming.
+fn pause_before_rename() {
+    if let Some(marker) = std::env::var_os("BIOTET_TEST_PAUSE_BEFORE_RENAME") {
+        let _ = std::fs::write(marker, b"");
+        loop {
+            std::thread::sleep(std::time::Duration::from_secs(1));
+        }
+    }
 }
 
 /// Read a whole file, naming it in the error.

@@ -103,7 +103,7 @@ impl Error {
         Error::Line {
             file: file.to_string(),
             line,
-            msg: msg.into(),
+            msg: one_line(msg.into()),
         }
     }
 
@@ -117,28 +117,58 @@ impl Error {
             file: file.to_string(),
             what,
             index,
-            msg: msg.into(),
+            msg: one_line(msg.into()),
         }
     }
 
     pub(crate) fn truncated(file: &str, msg: impl Into<String>) -> Error {
         Error::Truncated {
             file: file.to_string(),
-            msg: msg.into(),
+            msg: one_line(msg.into()),
         }
     }
 
     pub(crate) fn format(file: &str, msg: impl Into<String>) -> Error {
         Error::Format {
             file: file.to_string(),
-            msg: msg.into(),
+            msg: one_line(msg.into()),
         }
     }
 
     pub(crate) fn invalid(file: &str, msg: impl Into<String>) -> Error {
         Error::InvalidMesh {
             file: file.to_string(),
-            msg: msg.into(),
+            msg: one_line(msg.into()),
         }
+    }
+}
+
+/// Messages quote the file's own text (a magic number, an attribute value), which may hold line
+/// breaks and other control characters: escaped, so that every error stays one line.
+fn one_line(msg: String) -> String {
+    if !msg.chars().any(char::is_control) {
+        return msg;
+    }
+    let mut out = String::with_capacity(msg.len() + 8);
+    for c in msg.chars() {
+        if c.is_control() {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn messages_are_one_line() {
+        let e = Error::format("a.nii", "magic '\n\u{1}5' is not 'n+1'");
+        assert_eq!(e.to_string(), "a.nii: magic '\\n\\u{1}5' is not 'n+1'");
+        let e = Error::line("a.vtu", 2, "unknown byte_order 'Little\r\nEndian'");
+        assert!(!e.to_string().contains(['\n', '\r']));
     }
 }

@@ -151,8 +151,19 @@ fn build(
         .map_err(|e| Error::format(file, e.to_string()))
 }
 
-/// `dims[0]·dims[1]·dims[2]`, refused above [`MAX_GRID_SAMPLES`].
+/// `dims[0]·dims[1]·dims[2]`, refused above [`MAX_GRID_SAMPLES`] or when its values (`f64`)
+/// exceed the memory budget ([`crate::limits`]).
 pub(crate) fn sample_count(dims: [usize; 3], file: &str) -> Result<usize> {
+    let n = checked_samples(dims, file)?;
+    crate::limits::reserve(
+        file,
+        &format!("a grid of {}", dims_text(dims)),
+        n as u64 * 8,
+    )?;
+    Ok(n)
+}
+
+fn checked_samples(dims: [usize; 3], file: &str) -> Result<usize> {
     dims[0]
         .checked_mul(dims[1])
         .and_then(|x| x.checked_mul(dims[2]))

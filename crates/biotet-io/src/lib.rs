@@ -44,6 +44,7 @@ pub mod error;
 pub mod gmsh;
 pub mod grid;
 pub mod image;
+pub mod limits;
 pub mod medit;
 pub mod obj;
 pub mod off;

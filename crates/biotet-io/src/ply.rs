@@ -199,6 +199,12 @@ pub fn parse(data: &[u8], file: &str) -> Result<SurfaceRead> {
                     .map_err(|_| err(format!("bad element count '{}'", show(toks[2]))))?;
                 let count =
                     usize::try_from(count).map_err(|_| err("element count too large".into()))?;
+                // A second vertex or face element would mix two meshes' indices and labels.
+                let name = toks[1];
+                if (name == b"vertex" || name == b"face") && elements.iter().any(|e| e.name == name)
+                {
+                    return Err(err(format!("a second '{}' element", show(name))));
+                }
                 elements.push(Element {
                     name: toks[1].to_vec(),
                     count,

@@ -310,6 +310,11 @@ impl<'a> Ctx<'a> {
                 ),
             ));
         }
+        crate::limits::reserve(
+            self.file,
+            &format!("array '{name}' ({total} bytes decompressed)"),
+            total,
+        )?;
         let mut out = Vec::with_capacity(total as usize);
         let mut pos = 3 * hs + nb * hs;
         for k in 0..nb {

@@ -47,6 +47,19 @@ pub fn memory_kb() -> (Option<u64>, Option<u64>) {
 pub fn run(a: Args) -> Result<ExitCode> {
     let stage = Stage::start(a.common.quiet, format!("reading {}", a.points.display()));
     let points = biotet_io::read_points(&a.points)?;
+    // 250 bytes a point measured (19,903 points: 5.0 MB); refused before any work above the limit.
+    let need = points.len() as u64 * 300;
+    let limit = biotet_io::limits::max_memory();
+    if need > limit {
+        anyhow::bail!(
+            "{}: the Delaunay of {} points needs about {} of memory, more than the limit of {} \
+             (--max-memory)",
+            a.points.display(),
+            points.len(),
+            biotet_io::limits::human(need),
+            biotet_io::limits::human(limit)
+        );
+    }
     let (_, rss_before) = memory_kb();
     stage.set(format!("triangulating {} points", points.len()));
     let t0 = Instant::now();

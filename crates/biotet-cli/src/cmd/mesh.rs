@@ -289,6 +289,19 @@ pub fn run(a: Args) -> Result<ExitCode> {
     if a.no_polish || a.no_improve {
         opts.polish = None;
     }
+    // Refused before any work when the estimate exceeds --max-memory.
+    let estimate = crate::memory::estimate_mesh(&surface, &sizing, &opts.deploy);
+    let limit = biotet_io::limits::max_memory();
+    if estimate.bytes > limit as f64 {
+        anyhow::bail!(
+            "{name}: meshing needs about {} of memory (about {:.0} nodes, {:.0} template voxels), \
+             more than the limit of {} (--max-memory); give a larger size or a larger limit",
+            biotet_io::limits::human(estimate.bytes.min(u64::MAX as f64) as u64),
+            estimate.nodes,
+            estimate.voxels,
+            biotet_io::limits::human(limit)
+        );
+    }
     // Each stage starts from what the previous ones left in use, not from their peaks. The sizing
     // goes in by value, to be freed after deployment.
     let (mut mesh, report) = mesh_surface(&surface, sizing, &opts, &mut |s| {

@@ -119,9 +119,16 @@ impl Scalar {
     }
 }
 
-/// The number of voxels, refused above the limit.
+/// The number of voxels, refused above the limit or when the voxels' values and labels (12
+/// bytes a voxel) exceed the memory budget.
 pub(crate) fn voxel_count(dims: [usize; 3], file: &str) -> Result<usize> {
-    crate::grid::sample_count(dims, file)
+    let n = crate::grid::sample_count(dims, file)?;
+    crate::limits::reserve(
+        file,
+        &format!("an image of {}×{}×{} voxels", dims[0], dims[1], dims[2]),
+        n as u64 * 12,
+    )?;
+    Ok(n)
 }
 
 /// A label from a float value: finite, integral, in `0..=u32::MAX`.
