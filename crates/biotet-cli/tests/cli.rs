@@ -1599,6 +1599,23 @@ fn remesh_replaces_a_zone_keeps_the_rest_and_refuses_a_missing_zone() {
         let check = biotet(&["check", s(&new), "-s", s(&surface)]);
         assert!(check.status.success(), "{zone:?}: {}", stderr(&check));
     }
+    // A refill far too fine for --max-memory: refused before the work, nothing written.
+    let big = dir.path().join("big.vtu");
+    let out = biotet(&[
+        "remesh",
+        s(&base),
+        "--sphere",
+        "0.3,0,0,0.4",
+        "--size",
+        "0.0005",
+        "--max-memory",
+        "64M",
+        "-o",
+        s(&big),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("--max-memory"), "{}", stderr(&out));
+    assert!(!big.exists());
     // No zone, or a zone with no tet: an error naming the input, nothing written.
     let none = dir.path().join("none.vtu");
     for args in [vec![], vec!["--sphere", "10,10,10,1"]] {

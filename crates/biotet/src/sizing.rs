@@ -109,6 +109,10 @@ impl SizingOptions {
 /// Why a sizing function cannot be built.
 #[derive(Debug, thiserror::Error)]
 pub enum SizingError {
+    /// The sizes would need more memory than the caller allows (a caller's check, e.g. the
+    /// CLI's `--max-memory` on each cavity `biotet remesh` refills).
+    #[error("{0}")]
+    OverBudget(String),
     /// A size or rate that must be positive and finite is not.
     #[error("{what} must be a positive finite number, got {value}")]
     NotPositive {

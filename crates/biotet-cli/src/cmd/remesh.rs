@@ -9,7 +9,7 @@ use biotet::TetMesh;
 use biotet::pipeline::PipelineOptions;
 use biotet::quality::QualityReport;
 use biotet::remesh::{RemeshReport, Zone, insert, remesh};
-use biotet::sizing::{SizeSpec, Sizing, SizingOptions};
+use biotet::sizing::{SizeSpec, Sizing, SizingError, SizingOptions};
 use serde_json::json;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -142,8 +142,23 @@ pub fn run(a: Args) -> Result<ExitCode> {
         Some(h) => SizeSpec::Uniform(h),
         None => SizeSpec::FromSurface { grading: a.grading },
     };
-    let sizing = |s: &biotet::SurfaceMesh| Sizing::new(s, SizingOptions::new(spec()));
     let opts = PipelineOptions::default();
+    // Each cavity is refused before its meshing starts when its estimate exceeds --max-memory.
+    let limit = biotet_io::limits::max_memory();
+    let sizing = |s: &biotet::SurfaceMesh| {
+        let z = Sizing::new(s, SizingOptions::new(spec()))?;
+        let e = crate::memory::estimate_mesh(s, &z, &opts.deploy);
+        if e.bytes > limit as f64 {
+            return Err(SizingError::OverBudget(format!(
+                "refilling a cavity needs about {} of memory (about {:.0} nodes), more than the \
+                 limit of {} (--max-memory); give a larger --size or a larger limit",
+                biotet_io::limits::human(e.bytes.min(u64::MAX as f64) as u64),
+                e.nodes,
+                biotet_io::limits::human(limit)
+            )));
+        }
+        Ok(z)
+    };
     let mut progress = |s: &str| stage.set(s.to_string());
     let (out, report, what): (TetMesh, RemeshReport, _) = match &a.insert {
         None => {
