@@ -2,8 +2,8 @@
 //! (a painter's algorithm: enough for a closed surface seen from outside, where the nearer
 //! triangle always covers the farther one it overlaps).
 
-use super::palette::{label_color, shade};
-use super::{Key, Polygon, Scene};
+use super::palette::{label_color, label_key, shade};
+use super::{Polygon, Scene};
 use biotet::mesh::tet::{NO_NEIGHBOR, TET_FACES, TetMesh};
 
 /// The direction to the eye, the usual isometric one: from +x, −y, +z looking at the centre,
@@ -75,14 +75,7 @@ pub fn boundary(mesh: &TetMesh) -> (Scene, usize) {
     // which looks along −eye); ties in input order, so the output is deterministic.
     faces.sort_by(|a, b| a.0.total_cmp(&b.0));
     let n = faces.len();
-    let key = Key::Labels(
-        regions
-            .iter()
-            .enumerate()
-            .filter(|&(r, _)| shown[r])
-            .map(|(r, &l)| (l, label_color(r)))
-            .collect(),
-    );
+    let key = label_key(&regions, &shown);
     (
         Scene {
             polygons: faces.into_iter().map(|(_, p)| p).collect(),

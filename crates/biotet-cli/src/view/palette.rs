@@ -1,6 +1,6 @@
 //! Colours: a qualitative palette for region labels and a sequential ramp for angles.
 
-use super::Rgb;
+use super::{Key, Rgb};
 
 /// Twelve colours that stay apart for the usual colour-vision deficiencies and on grey
 /// print; labels beyond twelve cycle with a darker shade.
@@ -59,4 +59,17 @@ pub fn ramp(t: f64) -> Rgb {
 /// `c` scaled by a shading factor in [0, 1].
 pub fn shade(c: Rgb, f: f64) -> Rgb {
     c.map(|x| (f64::from(x) * f.clamp(0.0, 1.0)).round() as u8)
+}
+
+/// The legend of the regions drawn: `regions` sorted (the mesh's labels), `shown[r]` whether
+/// region rank `r` appears in the picture.
+pub fn label_key(regions: &[u32], shown: &[bool]) -> Key {
+    Key::Labels(
+        regions
+            .iter()
+            .enumerate()
+            .filter(|&(r, _)| shown[r])
+            .map(|(r, &l)| (l, label_color(r)))
+            .collect(),
+    )
 }

@@ -3,7 +3,7 @@
 //!
 //! Floating point throughout: this draws, it decides nothing about the mesh.
 
-use super::palette::{label_color, ramp, shade};
+use super::palette::{label_color, label_key, ramp, shade};
 use super::{Key, Polygon, Rgb, Scene, Segment};
 use biotet::mesh::surface::SurfaceMesh;
 use biotet::mesh::tet::{NO_NEIGHBOR, TET_EDGES, TET_FACES, TetMesh};
@@ -238,14 +238,7 @@ pub fn cut(
         }
     }
     let key = match coloring {
-        Coloring::Label => Key::Labels(
-            regions
-                .iter()
-                .enumerate()
-                .filter(|&(r, _)| shown[r])
-                .map(|(r, &l)| (l, label_color(r)))
-                .collect(),
-        ),
+        Coloring::Label => label_key(&regions, &shown),
         Coloring::Quality => Key::Bar {
             range: [0.0, REGULAR_DEG],
             ticks: vec![0.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0],

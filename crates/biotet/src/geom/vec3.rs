@@ -53,3 +53,18 @@ pub fn norm2(a: [f64; 3]) -> f64 {
 pub fn volume6(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> f64 {
     dot(sub(b, a), cross(sub(c, a), sub(d, a)))
 }
+
+/// The axis-aligned box `(lo, hi)` of `N` points (a triangle's or a tet's corners): exact, as
+/// min and max are; callers cull with it before exact tests.
+#[inline]
+pub fn bbox<const N: usize>(c: &[[f64; 3]; N]) -> ([f64; 3], [f64; 3]) {
+    let mut lo = c[0];
+    let mut hi = c[0];
+    for p in &c[1..] {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    (lo, hi)
+}

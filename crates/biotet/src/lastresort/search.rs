@@ -47,6 +47,7 @@
 use crate::geom::filter::orient3d;
 use crate::geom::intersect::{TriTri, is_degenerate, seg_tri, tri_tri};
 use crate::geom::predicates::{Sign, in_exact_range};
+pub(super) use crate::geom::vec3::bbox;
 use crate::geom::vec3::{cross, norm, norm2, sub};
 use crate::quality::tet::{min_dihedral_chord2, q_measure, volume};
 use rustc_hash::FxHashMap;
@@ -398,20 +399,6 @@ fn canon(f: [u32; 3]) -> [u32; 3] {
 #[inline]
 fn same_set(a: [u32; 3], b: [u32; 3]) -> bool {
     a.iter().all(|x| b.contains(x))
-}
-
-/// Bounding box of a triangle's or a tet's corners.
-#[inline]
-pub(super) fn bbox<const N: usize>(c: &[P3; N]) -> (P3, P3) {
-    let mut lo = c[0];
-    let mut hi = c[0];
-    for p in &c[1..] {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    (lo, hi)
 }
 
 #[inline]

@@ -204,19 +204,6 @@ impl<'a> SurfaceIndex<'a> {
     }
 }
 
-/// The exact box of a tet's corners.
-fn tet_box(c: &[P3; 4]) -> (P3, P3) {
-    let mut lo = c[0];
-    let mut hi = c[0];
-    for p in &c[1..] {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    (lo, hi)
-}
-
 /// What a boundary or interface face separates, for messages.
 fn separates(a: u32, b: Option<u32>) -> String {
     match b {
@@ -327,7 +314,7 @@ fn carve(
     let (lo, hi) = (index.lo.map(|x| x - margin), index.hi.map(|x| x + margin));
     for (t, slot) in carved.iter_mut().enumerate() {
         let c = mesh.corners(t);
-        let (tlo, thi) = tet_box(&c);
+        let (tlo, thi) = crate::geom::vec3::bbox(&c);
         if !(0..3).all(|k| tlo[k] <= hi[k] && thi[k] >= lo[k]) {
             continue;
         }

@@ -11,7 +11,7 @@ type P3 = [f64; 3];
 /// of what to replace, not a combinatorial decision of the mesh.
 pub(super) fn meets(zone: &Zone, label: u32, c: &[P3; 4]) -> bool {
     // The tet's box first: most tets of a large mesh are far from a small zone.
-    let (tlo, thi) = bounds(c);
+    let (tlo, thi) = crate::geom::vec3::bbox(c);
     match *zone {
         Zone::Region(r) => label == r,
         Zone::Box { lo, hi } => {
@@ -29,19 +29,6 @@ pub(super) fn meets(zone: &Zone, label: u32, c: &[P3; 4]) -> bool {
             gap <= radius * radius && tet_distance(c, centre) <= radius
         }
     }
-}
-
-/// The box of a tet's corners.
-fn bounds(c: &[P3; 4]) -> (P3, P3) {
-    let mut lo = c[0];
-    let mut hi = c[0];
-    for p in &c[1..] {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    (lo, hi)
 }
 
 /// Separating-axis test of a tet and an axis-aligned box (both closed).
