@@ -390,6 +390,13 @@ fn check_zone(o: &MeshOptions) -> PyResult<()> {
     }
 }
 
+/// The checks every meshing call makes while it holds the GIL: the zone, and the size field's
+/// numpy samples copied out (taken from the options, which then cross into the worker).
+fn take_field(py: Python<'_>, o: &mut MeshOptions) -> PyResult<Option<SizeField>> {
+    check_zone(o)?;
+    o.size_field.take().map(|f| f.resolve(py)).transpose()
+}
+
 /// Mesh the volume inside a closed surface given as arrays (see `biotet.mesh`).
 #[pyfunction]
 #[pyo3(signature = (points, triangles, shell_labels, side_labels, name, options, threads,
@@ -406,12 +413,7 @@ fn mesh_arrays<'py>(
     threads: Option<usize>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<MeshOut<'py>> {
-    check_zone(&options)?;
-    let field = options
-        .size_field
-        .take()
-        .map(|f| f.resolve(py))
-        .transpose()?;
+    let field = take_field(py, &mut options)?;
     let surface = surface_from(
         &points,
         &triangles,
@@ -441,12 +443,7 @@ fn mesh_image<'py>(
     threads: Option<usize>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<MeshOut<'py>> {
-    check_zone(&options)?;
-    let field = options
-        .size_field
-        .take()
-        .map(|f| f.resolve(py))
-        .transpose()?;
+    let field = take_field(py, &mut options)?;
     let (values, dims) = volume_from(&labels);
     let img = LabelImage::new(dims, affine, values)
         .map_err(|e| pyo3::exceptions::PyValueError::new_err(format!("labels: {e}")))?;
@@ -525,12 +522,7 @@ fn mesh_files<'py>(
     threads: Option<usize>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<MeshOut<'py>> {
-    check_zone(&options)?;
-    let field = options
-        .size_field
-        .take()
-        .map(|f| f.resolve(py))
-        .transpose()?;
+    let field = take_field(py, &mut options)?;
     let (mesh, report) = guarded(py, threads, move || {
         let progress = |s: &str| run::report_progress(progress.as_ref(), s);
         let input = match &paths[..] {
