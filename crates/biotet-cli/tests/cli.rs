@@ -1628,6 +1628,76 @@ fn remesh_replaces_a_zone_keeps_the_rest_and_refuses_a_missing_zone() {
     }
 }
 
+/// A .vti grid over [-1.5, 1.5]³ (7 points a side) whose value is `f(x)`.
+fn size_vti(path: &std::path::Path, f: impl Fn(f64) -> f64) {
+    let (n, o, sp) = (7, -1.5, 0.5);
+    let mut vals = Vec::new();
+    for _k in 0..n {
+        for _j in 0..n {
+            for i in 0..n {
+                vals.push(f(o + i as f64 * sp).to_string());
+            }
+        }
+    }
+    std::fs::write(
+        path,
+        format!(
+            "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"0.1\" byte_order=\"LittleEndian\">\n\
+             <ImageData WholeExtent=\"0 6 0 6 0 6\" Origin=\"{o} {o} {o}\" Spacing=\"{sp} {sp} {sp}\">\n\
+             <Piece Extent=\"0 6 0 6 0 6\"><PointData Scalars=\"size\">\
+             <DataArray type=\"Float64\" Name=\"size\" format=\"ascii\">{}</DataArray>\
+             </PointData></Piece></ImageData></VTKFile>\n",
+            vals.join(" ")
+        ),
+    )
+    .unwrap();
+}
+
+#[test]
+fn remesh_takes_a_size_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let surface = root().join("tests/data/shapes/tm_icosphere.off");
+    let base = dir.path().join("base.vtu");
+    let out = biotet(&["mesh", s(&surface), "-o", s(&base), "--quiet"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let added = |args: &[&str]| {
+        let new = dir.path().join("new.vtu");
+        let mut a = vec!["remesh", s(&base), "--region", "1", "-o", s(&new), "--json"];
+        a.extend_from_slice(args);
+        let out = biotet(&a);
+        assert!(out.status.success(), "{args:?}: {}", stderr(&out));
+        let check = biotet(&["check", s(&new), "-s", s(&surface)]);
+        assert!(check.status.success(), "{args:?}: {}", stderr(&check));
+        json_of(&out)["remesh"]["tets_after"].as_u64().unwrap()
+    };
+    // Fine (0.1) where x > 0, coarse (0.3) elsewhere: between the two uniform refills.
+    let graded = dir.path().join("graded.vti");
+    size_vti(&graded, |x| if x > 0.0 { 0.1 } else { 0.3 });
+    let (fine, coarse) = (added(&["--size", "0.1"]), added(&["--size", "0.3"]));
+    let field = added(&["--size-field", s(&graded)]);
+    assert!(
+        coarse < field && field < fine,
+        "{coarse} < {field} < {fine}"
+    );
+    // A field with a value at or below 0 is refused before any work, nothing written.
+    let bad = dir.path().join("bad.vti");
+    size_vti(&bad, |x| x);
+    let none = dir.path().join("none.vtu");
+    let out = biotet(&[
+        "remesh",
+        s(&base),
+        "--region",
+        "1",
+        "--size-field",
+        s(&bad),
+        "-o",
+        s(&none),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("bad.vti"), "{}", stderr(&out));
+    assert!(!none.exists());
+}
+
 /// An ellipsoid (icosphere of two levels, radii `r`) centred at `c`, as OFF text.
 fn ellipsoid_off(c: [f64; 3], r: [f64; 3]) -> String {
     let e = biotet::SurfaceMesh::icosphere(1.0, 2);

@@ -46,11 +46,16 @@ impl SizeSpec {
     /// it), refused unless every value is positive. `frame_to_world` maps the points the mesher
     /// asks about to the grid's coordinates: set for an oblique label image meshed in its
     /// axis-aligned frame ([`crate::image::LabelImage::to_frame`]), where the grid is in world.
-    pub fn from_grid(
-        grid: crate::sizing_grid::ScalarGrid,
+    /// The grid is taken as owned or shared (`Arc`: one grid for several sizings, as remesh's
+    /// cavities use).
+    pub fn from_grid<G>(
+        grid: G,
         frame_to_world: Option<[[f64; 4]; 4]>,
-    ) -> Result<SizeSpec, SizingError> {
-        let (min, max) = (grid.min_value(), grid.max_value());
+    ) -> Result<SizeSpec, SizingError>
+    where
+        G: std::borrow::Borrow<crate::sizing_grid::ScalarGrid> + Send + Sync + 'static,
+    {
+        let (min, max) = (grid.borrow().min_value(), grid.borrow().max_value());
         if min.is_nan() || min <= 0.0 {
             return Err(SizingError::FieldNotPositive { min });
         }
@@ -60,7 +65,7 @@ impl SizeSpec {
                 if let Some(m) = &frame_to_world {
                     crate::image::map_points(m, &mut q);
                 }
-                grid.value_at(q[0])
+                grid.borrow().value_at(q[0])
             }),
             min,
             max,

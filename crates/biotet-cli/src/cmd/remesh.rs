@@ -20,6 +20,7 @@ Examples:
   biotet remesh head.vtu --region 2 --size 1.5 -o head_fine_wm.vtu
   biotet remesh head.vtu --sphere 10,-20,35,10 --size 0.8 -o head_electrode.vtu
   biotet remesh head.vtu --box 0,0,0,20,20,20 --size 3 -o head_coarse.vtu --json
+  biotet remesh head.vtu --region 3 --size-field sizes.vti -o head_graded_csf.vtu
   biotet remesh head.vtu --insert lesion.stl --label 5 --margin 2 -o head_lesion.vtu
 
 --insert embeds a closed surface lying inside one region: the tets meeting it and those within
@@ -67,10 +68,17 @@ pub struct Args {
     /// (default: --size, or the surface's mean edge length).
     #[arg(long, value_name = "M", requires = "insert")]
     margin: Option<f64>,
-    /// Uniform size of the new tets. Without it, sizes come from the cavity's shell (its edges,
-    /// growing inward by --grading).
-    #[arg(long, value_name = "H")]
+    /// Uniform size of the new tets. Without it (or --size-field), sizes come from the cavity's
+    /// shell (its edges, growing inward by --grading).
+    #[arg(long, value_name = "H", conflicts_with = "size_field")]
     size: Option<f64>,
+    /// Size of the new tets from a regular grid file (VTK image data .vti, NIfTI .nii/.nii.gz),
+    /// interpolated trilinearly, clamped to the grid outside it; in the mesh's coordinates.
+    #[arg(long, value_name = "FILE")]
+    size_field: Option<PathBuf>,
+    /// Which array of a .vti size field (default: the active point scalars, else the first).
+    #[arg(long, value_name = "NAME", requires = "size_field")]
+    size_field_array: Option<String>,
     /// Growth of the shell-derived size per unit distance (without --size).
     #[arg(long, value_name = "G", default_value_t = 0.3)]
     grading: f64,
@@ -138,15 +146,29 @@ pub fn run(a: Args) -> Result<ExitCode> {
     let stage = Stage::start(a.common.quiet, format!("reading {}", a.mesh.display()));
     let mesh = super::input::tet_mesh(&a.mesh, a.common)?;
     let name = a.mesh.display().to_string();
-    let spec = || match a.size {
-        Some(h) => SizeSpec::Uniform(h),
-        None => SizeSpec::FromSurface { grading: a.grading },
+    // One grid shared by every cavity's sizing.
+    let field = match &a.size_field {
+        Some(path) => {
+            let grid = std::sync::Arc::new(biotet_io::read_scalar_grid_named(
+                path,
+                a.size_field_array.as_deref(),
+            )?);
+            // Checked once here, so each cavity's use below cannot fail.
+            SizeSpec::from_grid(grid.clone(), None).with_context(|| path.display().to_string())?;
+            Some(grid)
+        }
+        None => None,
+    };
+    let spec = || match (a.size, &field) {
+        (Some(h), _) => Ok(SizeSpec::Uniform(h)),
+        (None, Some(grid)) => SizeSpec::from_grid(grid.clone(), None),
+        (None, None) => Ok(SizeSpec::FromSurface { grading: a.grading }),
     };
     let opts = PipelineOptions::default();
     // Each cavity is refused before its meshing starts when its estimate exceeds --max-memory.
     let limit = biotet_io::limits::max_memory();
     let sizing = |s: &biotet::SurfaceMesh| {
-        let z = Sizing::new(s, SizingOptions::new(spec()))?;
+        let z = Sizing::new(s, SizingOptions::new(spec()?))?;
         let e = crate::memory::estimate_mesh(s, &z, &opts.deploy);
         if e.bytes > limit as f64 {
             return Err(SizingError::OverBudget(format!(

@@ -729,6 +729,16 @@ struct Speculative {
     calls: Vec<(f64, u64, usize)>,
 }
 
+/// What the crossed-tets stage found (see [`View::try_crossed`]).
+enum Crossed {
+    /// A fill, not yet inserted.
+    Filled(Speculative),
+    /// Both cavities searched without a fill (the calls' time, nodes and size).
+    Failed { calls: Vec<(f64, u64, usize)> },
+    /// No crossed tets, or too many for this stage.
+    Skipped,
+}
+
 /// A cavity point made by the kernel fallback, not yet a mesh point (see [`pending_id`]).
 const PENDING: u32 = u32::MAX;
 
@@ -866,7 +876,7 @@ impl View<'_> {
     /// Refilling just these recovers most triangles at a fraction of the cost of the corners'
     /// cavity (a few tets instead of dozens). `None` when there are more than
     /// [`CROSSED_MAX_TETS`].
-    fn crossed_tets(&self, w: &mut Work, v: [u32; 3]) -> Option<Vec<u32>> {
+    fn crossed_tets(&self, w: &mut Work, v: [u32; 3], limit: usize) -> Option<Vec<u32>> {
         let tp = v.map(|x| self.mesh.points[x as usize]);
         let (lo, hi) = bbox(&tp);
         let st = w.next_stamp();
@@ -924,7 +934,7 @@ impl View<'_> {
             }
             if crossed {
                 out.push(t);
-                if out.len() > CROSSED_MAX_TETS {
+                if out.len() > limit {
                     w.walk_buf = stack;
                     return None;
                 }
@@ -1338,12 +1348,14 @@ impl View<'_> {
     }
 
     /// The crossed-tets stage of [`Recovery::attempt`] (the tets `v` crosses, then those and
-    /// their face neighbours), without inserting; `None` when neither fills.
-    fn try_crossed(&self, w: &mut Work, v: [u32; 3]) -> Option<Speculative> {
-        let crossed = self.crossed_tets(w, v)?;
+    /// their face neighbours), without inserting.
+    fn try_crossed(&self, w: &mut Work, v: [u32; 3]) -> Crossed {
+        let Some(crossed) = self.crossed_tets(w, v, CROSSED_MAX_TETS) else {
+            return Crossed::Skipped;
+        };
         let mut calls = Vec::new();
         if let Ok((cav, new_tets)) = self.carve_fill(w, v, &crossed, &mut calls) {
-            return Some(Speculative {
+            return Crossed::Filled(Speculative {
                 cav,
                 new_tets,
                 calls,
@@ -1351,12 +1363,14 @@ impl View<'_> {
         }
         let mut ring = crossed;
         self.grow(w, &mut ring);
-        let (cav, new_tets) = self.carve_fill(w, v, &ring, &mut calls).ok()?;
-        Some(Speculative {
-            cav,
-            new_tets,
-            calls,
-        })
+        match self.carve_fill(w, v, &ring, &mut calls) {
+            Ok((cav, new_tets)) => Crossed::Filled(Speculative {
+                cav,
+                new_tets,
+                calls,
+            }),
+            Err(_) => Crossed::Failed { calls },
+        }
     }
 }
 
@@ -1630,10 +1644,12 @@ impl<'a> Recovery<'a> {
                 w.get_mut().unwrap_or_else(|e| e.into_inner()).fit(nt, np);
             }
             let view = self.view();
-            let found: Vec<Option<Speculative>> = batch
+            let found: Vec<Crossed> = batch
                 .par_iter()
                 .map(|&s| {
-                    let v = view.tri_map[s as usize]?;
+                    let Some(v) = view.tri_map[s as usize] else {
+                        return Crossed::Skipped;
+                    };
                     let k = rayon::current_thread_index().unwrap_or(0) % pool.len();
                     let mut w = pool[k].lock().unwrap_or_else(|e| e.into_inner());
                     view.try_crossed(&mut w, v)
@@ -1642,6 +1658,9 @@ impl<'a> Recovery<'a> {
             if let Some(w) = pool.pop() {
                 self.work = w.into_inner().unwrap_or_else(|e| e.into_inner());
             }
+            // Whether this batch has changed the mesh yet: until it has, a failed crossed stage
+            // stands as tried on the mesh as it is.
+            let mut changed = false;
             for (i, (&s, found)) in batch.iter().zip(found).enumerate() {
                 let Some(v) = self.tri_map[s as usize] else {
                     continue;
@@ -1653,35 +1672,41 @@ impl<'a> Recovery<'a> {
                 if stalled > queue.len() + wait.len() + (batch.len() - i - 1) {
                     return;
                 }
-                match found {
-                    Some(f) if !self.stale(&f.cav) => {
-                        for &(ms, nodes, size) in &f.calls {
-                            self.call_ms.push(ms);
-                            self.call_nodes.push(nodes);
-                            self.call_sizes.push(size);
-                        }
+                let tried = match found {
+                    Crossed::Filled(f) if !self.stale(&f.cav) => {
+                        self.record_calls(&f.calls);
                         self.crossed_tried += 1;
                         self.crossed_ok += 1;
                         self.calls_ok += 1;
                         self.insert(&f.cav, &f.new_tets);
+                        changed = true;
                         stalled = 0;
                         self.reason.remove(&s);
+                        continue;
                     }
-                    Some(_) => wait.push(s),
-                    None => {
-                        if self.attempt(s, v, false) {
-                            stalled = 0;
-                            self.reason.remove(&s);
-                        } else {
-                            // Bounded by work: a triangle failed this often is left to the
-                            // Steiner fallback (or reported), not retried after every success.
-                            let n = self.tries.entry(s).or_insert(0);
-                            *n += 1;
-                            if u32::from(*n) < self.opts.max_tries {
-                                stalled += 1;
-                                queue.push_back(s);
-                            }
-                        }
+                    Crossed::Filled(_) => {
+                        wait.push(s);
+                        continue;
+                    }
+                    Crossed::Failed { calls } if !changed => {
+                        self.record_calls(&calls);
+                        self.crossed_tried += 1;
+                        true
+                    }
+                    _ => false,
+                };
+                if self.attempt_after(s, v, false, tried) {
+                    changed = true;
+                    stalled = 0;
+                    self.reason.remove(&s);
+                } else {
+                    // Bounded by work: a triangle failed this often is left to the Steiner
+                    // fallback (or reported), not retried after every success.
+                    let n = self.tries.entry(s).or_insert(0);
+                    *n += 1;
+                    if u32::from(*n) < self.opts.max_tries {
+                        stalled += 1;
+                        queue.push_back(s);
                     }
                 }
             }
@@ -1708,7 +1733,32 @@ impl<'a> Recovery<'a> {
     /// With `kernel` (the Steiner fallback), the small cavities come first too: a cell of few
     /// faces is more likely star-shaped, and its cone is small.
     fn attempt(&mut self, s: u32, v: [u32; 3], kernel: bool) -> bool {
-        if let Some(crossed) = self.with_work(|view, w| view.crossed_tets(w, v)) {
+        self.attempt_after(s, v, kernel, false)
+    }
+
+    /// Time, search nodes and cavity size of calls made on a view.
+    fn record_calls(&mut self, calls: &[(f64, u64, usize)]) {
+        for &(ms, nodes, size) in calls {
+            self.call_ms.push(ms);
+            self.call_nodes.push(nodes);
+            self.call_sizes.push(size);
+        }
+    }
+
+    /// [`Self::attempt`], the crossed stage not repeated when `tried` says it already failed
+    /// on the mesh as it is.
+    fn attempt_after(&mut self, s: u32, v: [u32; 3], kernel: bool, tried: bool) -> bool {
+        // Wide rounds take the crossed tets however many (within the cavity bound): a surface
+        // triangle far larger than the interior spacing crosses hundreds, and a cavity grown
+        // from its corners alone would not reach its middle.
+        let limit = if self.wide {
+            self.opts.max_cavity_tets
+        } else {
+            CROSSED_MAX_TETS
+        };
+        let crossed = self.with_work(|view, w| view.crossed_tets(w, v, limit));
+        let enclosing = crossed.clone();
+        if let Some(crossed) = crossed.filter(|_| !tried) {
             self.crossed_tried += 1;
             if self.carve_and_fill(v, &crossed, kernel).is_ok() {
                 self.crossed_ok += 1;
@@ -1727,6 +1777,10 @@ impl<'a> Recovery<'a> {
         let mut tets = self.with_work(|view, w| {
             let st = w.next_stamp();
             let mut tets = Vec::new();
+            for &t in enclosing.iter().flatten() {
+                w.tet_mark[t as usize] = low(st);
+                tets.push(t);
+            }
             for &c in &v {
                 for t in view.star(w, c) {
                     if w.tet_mark[t as usize] != low(st) {

@@ -8,13 +8,15 @@
 //! the corner zones alone keep nodes at least that same height away.
 //!
 //! A sealed triangle's smallest circumsphere is cleared too, unless the triangle is obtuse beyond
-//! 150° or its circumradius exceeds [`BALL_MAX_SIZES`] sizes: no interior node then keeps it out of
-//! the Delaunay tetrahedralization, which is what keeps recovery linear when the size is finer than
+//! 150° or its circumradius exceeds [`BALL_MAX_SIZES`] sizes (then, for a boundary triangle up to
+//! [`CAP_MAX_SIZES`], the flattest inner cap of a sphere through its corners that no other
+//! surface point enters): no interior node then keeps it out of the Delaunay tetrahedralization, which is what keeps recovery linear when the size is finer than
 //! the surface (brain_20k at `--size 1.0`: 6,132 missing triangles instead of 11,063, recovery
 //! 2.9 s instead of 62 s).
 
 use crate::geom::vec3::{add, cross, dot, norm, scale, sub};
 use crate::mesh::surface::SurfaceMesh;
+use crate::surface::grid::Grid;
 use rayon::prelude::*;
 
 use super::voxels::{BUFFER, SURFACE_NODE, Template, UNPROCESSED, Zone};
@@ -41,6 +43,11 @@ pub fn mark_surface_nodes(t: &mut Template, surface: &SurfaceMesh, size: &[f64],
 /// most this many times the smallest size at its corners.
 pub const BALL_MAX_SIZES: f64 = 3.0;
 
+/// A boundary triangle whose circumradius is above [`BALL_MAX_SIZES`] sizes but at most this
+/// many has the inner cap of a larger sphere through its corners cleared instead of its ball
+/// (see [`cap_height`]).
+pub const CAP_MAX_SIZES: f64 = 32.0;
+
 /// Triangles per wave of [`seal_triangles`], and per parallel piece of a wave: bounded memory
 /// for the voxel lists, enough pieces to share.
 const WAVE: usize = 4096;
@@ -53,14 +60,17 @@ const PIECE: usize = 128;
 /// result is the same on any number of threads.
 pub fn seal_triangles(t: &mut Template, surface: &SurfaceMesh, size: &[f64]) -> usize {
     let mut sealed = 0;
-    for wave in surface.triangles.chunks(WAVE) {
+    let points = point_grid(surface);
+    let n_tri = surface.triangles.len();
+    let ids: Vec<usize> = (0..n_tri).collect();
+    for wave in ids.chunks(WAVE) {
         let found: Vec<(usize, Vec<usize>)> = wave
             .par_chunks(PIECE)
             .map(|piece| {
                 let mut out = Vec::new();
                 let n = piece
                     .iter()
-                    .filter(|tri| seal_one(t, surface, size, **tri, &mut out))
+                    .filter(|&&s| seal_one(t, surface, &points, size, s, &mut out))
                     .count();
                 (n, out)
             })
@@ -81,12 +91,13 @@ pub fn seal_triangles(t: &mut Template, surface: &SurfaceMesh, size: &[f64]) -> 
 fn seal_one(
     t: &Template,
     surface: &SurfaceMesh,
+    points: &Grid,
     size: &[f64],
-    tri: [u32; 3],
+    s: usize,
     out: &mut Vec<usize>,
 ) -> bool {
     {
-        let v = tri.map(|i| i as usize);
+        let v = surface.triangles[s].map(|i| i as usize);
         let p = v.map(|i| surface.points[i]);
         let d = v.map(|i| size[i]);
         let edges = [
@@ -122,16 +133,24 @@ fn seal_one(
         prism_voxels(t, q, h, n, out);
         // Interior spacing finer than the triangle: nodes inside its smallest circumsphere keep
         // it out of the Delaunay, and recovery's cavities grow with the square of the ratio.
-        // Clearing the sphere makes the triangle Gabriel against interior nodes. Skipped for
-        // obtuse slivers (circumradius above the longest edge, an angle over 150°) and for
-        // triangles far larger than the size (a CAD face): their sphere would empty the
-        // interior, and recovery handles them with few cavities.
+        // Clearing the sphere makes the triangle Gabriel against interior nodes. Larger
+        // triangles on the boundary get the flattest cap that makes them Delaunay instead
+        // (none on a convex part, where the prism is enough): the whole ball would empty the
+        // interior. Skipped for obtuse
+        // slivers (circumradius above the longest edge, an angle over 150°) and for triangles
+        // far larger still (a CAD face), which recovery handles with few cavities.
         let dmin = d.iter().copied().fold(f64::INFINITY, f64::min);
         if let Some((c, r)) = circumsphere(p)
             && r <= longest
-            && r <= BALL_MAX_SIZES * dmin
         {
-            ball_voxels(t, c, r, out);
+            if r <= BALL_MAX_SIZES * dmin {
+                ball_voxels(t, c, r, out);
+            } else if r <= CAP_MAX_SIZES * dmin
+                && let Some(inward) = inward_normal(surface.sides[s], n)
+                && let Some(h) = cap_height(surface, points, s, c, r, inward, dmin * HEIGHT_FACTOR)
+            {
+                cap_voxels(t, c, r, h, inward, out);
+            }
         }
         true
     }
@@ -181,6 +200,139 @@ fn ball_voxels(t: &Template, c: [f64; 3], r: f64, out: &mut Vec<usize>) {
                 }
                 let d = sub(t.point([i, j, k]), c);
                 if dot(d, d) < r2 {
+                    out.push(idx);
+                }
+            }
+        }
+    }
+}
+
+/// The unit normal pointing into the meshed side of a triangle whose other side is the outside
+/// (label 0); `None` for an interface (both sides meshed).
+fn inward_normal(sides: [u32; 2], n: [f64; 3]) -> Option<[f64; 3]> {
+    match sides {
+        [b, 0] if b != 0 => Some(scale(n, -1.0)),
+        [0, f] if f != 0 => Some(n),
+        _ => None,
+    }
+}
+
+/// The surface's points in a hashed grid of cells about twice its mean edge length (each point
+/// listed as a triangle with three equal corners).
+fn point_grid(surface: &SurfaceMesh) -> Grid {
+    let mut sum = 0.0;
+    for tri in &surface.triangles {
+        let p = tri.map(|i| surface.points[i as usize]);
+        sum += norm(sub(p[1], p[0])) + norm(sub(p[2], p[1])) + norm(sub(p[0], p[2]));
+    }
+    let mean = sum / (3 * surface.triangles.len()).max(1) as f64;
+    let mut g = Grid::new(if mean > 0.0 && mean.is_finite() {
+        2.0 * mean
+    } else {
+        1.0
+    });
+    for (i, p) in surface.points.iter().enumerate() {
+        g.insert(i as u32, &[*p; 3]);
+    }
+    g
+}
+
+/// The height, on the side `inward`, of the smallest cap to clear over boundary triangle `s`
+/// (circumcentre `c`, circumradius `r`) so that a sphere through its corners holds no other
+/// surface point, or `None` when its prism (height `prism`) is enough or no such sphere exists.
+///
+/// The spheres through the corners have centres `c − t·inward`, radius² `r² + t²`. A point `q`
+/// with `a = |q − c|² − r²` and `b = (q − c)·inward` is inside for `a + 2tb < 0`: points behind
+/// the plane bound `t` from above, points in front inside the smallest sphere from below. The
+/// largest allowed `t` (the flattest cap, searched up to a cap of about r/8) is taken, slightly
+/// less so the point that bounds it stays outside. Floating point: this only chooses voxels.
+fn cap_height(
+    surface: &SurfaceMesh,
+    points: &Grid,
+    s: usize,
+    c: [f64; 3],
+    r: f64,
+    inward: [f64; 3],
+    prism: f64,
+) -> Option<f64> {
+    let h0 = prism.max(r / 8.0).min(r);
+    let far = (r * r - h0 * h0) / (2.0 * h0);
+    let big = (r * r + far * far).sqrt();
+    let centre = add(c, scale(inward, -far));
+    let mut lo = [0.0; 3];
+    let mut hi = [0.0; 3];
+    for k in 0..3 {
+        lo[k] = (centre[k] - big).min(c[k] - r);
+        hi[k] = (centre[k] + big).max(c[k] + r);
+    }
+    let mut near = Vec::new();
+    points.query(lo, hi, &mut near);
+    let corners = surface.triangles[s];
+    let (mut t_lo, mut t_hi) = (0.0f64, far);
+    for &i in &near {
+        if corners.contains(&i) {
+            continue;
+        }
+        let d = sub(surface.points[i as usize], c);
+        let (a, b) = (dot(d, d) - r * r, dot(d, inward));
+        if b < 0.0 {
+            if a <= 0.0 {
+                return None;
+            }
+            t_hi = t_hi.min(a / (-2.0 * b));
+        } else if b > 0.0 {
+            if a < 0.0 {
+                t_lo = t_lo.max(-a / (2.0 * b));
+            }
+        } else if a < 0.0 {
+            return None;
+        }
+    }
+    if t_hi <= t_lo {
+        return None;
+    }
+    let t = if t_hi < far {
+        (0.99 * t_hi).max(0.5 * (t_lo + t_hi))
+    } else {
+        far
+    };
+    let h = (r * r + t * t).sqrt() - t;
+    (h > prism).then_some(h)
+}
+
+/// The unprocessed voxels strictly inside the cap, of height `h` on the side `inward`, of the
+/// sphere through the triangle's corners whose centre lies on the other side (circumcentre `c`,
+/// circumradius `r > h`): with that cap empty, the triangle is a Delaunay face unless a surface
+/// point lies in the sphere's outer part.
+fn cap_voxels(t: &Template, c: [f64; 3], r: f64, h: f64, inward: [f64; 3], out: &mut Vec<usize>) {
+    // Centre at distance d behind the plane, radius R: R − d = h and R² = r² + d².
+    let d = (r * r - h * h) / (2.0 * h);
+    let big = d + h;
+    let centre = add(c, scale(inward, -d));
+    let top = add(c, scale(inward, h));
+    let inv = 1.0 / t.dx;
+    let span = |a: usize| {
+        let lo = c[a].min(top[a]) - r;
+        let hi = c[a].max(top[a]) + r;
+        let l = ((lo - t.origin[a]) * inv).ceil().max(0.0) as usize;
+        let u = ((hi - t.origin[a]) * inv).floor();
+        (l, (u >= 0.0).then(|| (u as usize).min(t.n[a] - 1)))
+    };
+    let ((i0, Some(i1)), (j0, Some(j1)), (k0, Some(k1))) = (span(0), span(1), span(2)) else {
+        return;
+    };
+    let big2 = big * big;
+    for k in k0..=k1 {
+        for j in j0..=j1 {
+            let row = t.index(0, j, k);
+            for i in i0..=i1 {
+                let idx = row + i;
+                if t.state(idx) != UNPROCESSED {
+                    continue;
+                }
+                let x = t.point([i, j, k]);
+                let e = sub(x, centre);
+                if dot(sub(x, c), inward) > 0.0 && dot(e, e) < big2 {
                     out.push(idx);
                 }
             }

@@ -144,6 +144,23 @@ fn remeshing_a_sphere_and_a_box_across_the_interface() {
     }
 }
 
+/// A ball refilled six times finer than its shell's triangles (coarse triangles around fine
+/// nodes: recovery failed here with "the cavity grew too large" before the seal cleared caps
+/// over large boundary triangles and wide rounds started from the crossed tets).
+#[test]
+fn a_ball_far_finer_than_its_shell() {
+    let (s, m) = nested();
+    let zone = Zone::Sphere {
+        centre: [2.7, 0.0, 0.0],
+        radius: 0.9,
+    };
+    let (out, r) = run(&m, zone, 0.1);
+    let changed: usize = r.cavities.iter().map(|c| c.tets_added).sum();
+    assert_in_place(&s, &m, &out, r.tets_kept, changed);
+    let removed = m.tets.len() - r.tets_kept;
+    assert!(changed > 20 * removed, "{removed} → {changed}");
+}
+
 #[test]
 fn a_zone_with_no_tet_is_refused() {
     let (_, m) = nested();
