@@ -1654,7 +1654,7 @@ fn size_vti(path: &std::path::Path, f: impl Fn(f64) -> f64) {
 }
 
 #[test]
-fn remesh_takes_a_size_field() {
+fn remesh_takes_a_size_field_and_allows_shell_changes() {
     let dir = tempfile::tempdir().unwrap();
     let surface = root().join("tests/data/shapes/tm_icosphere.off");
     let base = dir.path().join("base.vtu");
@@ -1679,6 +1679,28 @@ fn remesh_takes_a_size_field() {
         coarse < field && field < fine,
         "{coarse} < {field} < {fine}"
     );
+    // --allow-shell-changes: the kept tets offered and replaced are in the JSON, the mesh valid.
+    let new = dir.path().join("shell.vtu");
+    let out = biotet(&[
+        "remesh",
+        s(&base),
+        "--sphere",
+        "0.3,0,0,0.4",
+        "--size",
+        "0.3",
+        "--allow-shell-changes",
+        "-o",
+        s(&new),
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let j = json_of(&out);
+    let c = &j["remesh"]["shell_changes"];
+    let offered = c["kept_offered"].as_u64().unwrap();
+    assert!(offered > 0, "{c}");
+    assert!(c["kept_replaced"].as_array().unwrap().len() as u64 <= offered);
+    let check = biotet(&["check", s(&new), "-s", s(&surface)]);
+    assert!(check.status.success(), "{}", stderr(&check));
     // A field with a value at or below 0 is refused before any work, nothing written.
     let bad = dir.path().join("bad.vti");
     size_vti(&bad, |x| x);

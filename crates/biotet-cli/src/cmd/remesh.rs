@@ -8,7 +8,7 @@ use anyhow::{Context, Result, bail};
 use biotet::TetMesh;
 use biotet::pipeline::PipelineOptions;
 use biotet::quality::QualityReport;
-use biotet::remesh::{RemeshReport, Zone, insert, remesh};
+use biotet::remesh::{RemeshReport, Zone, across_shell, insert, remesh};
 use biotet::sizing::{SizeSpec, Sizing, SizingError, SizingOptions};
 use serde_json::json;
 use std::path::PathBuf;
@@ -22,6 +22,7 @@ Examples:
   biotet remesh head.vtu --box 0,0,0,20,20,20 --size 3 -o head_coarse.vtu --json
   biotet remesh head.vtu --region 3 --size-field sizes.vti -o head_graded_csf.vtu
   biotet remesh head.vtu --insert lesion.stl --label 5 --margin 2 -o head_lesion.vtu
+  biotet remesh head.vtu --region 2 --size 3 --allow-shell-changes -o head_coarse_wm.vtu
 
 --insert embeds a closed surface lying inside one region: the tets meeting it and those within
 --margin of it are refilled, its inside labelled L. Without --size the sizes come from the
@@ -79,6 +80,11 @@ pub struct Args {
     /// Which array of a .vti size field (default: the active point scalars, else the first).
     #[arg(long, value_name = "NAME", requires = "size_field")]
     size_field_array: Option<String>,
+    /// Let sliver removal work across the zone's shell: the kept tets sharing a corner with the
+    /// new ones may be replaced too (no point added, moved or dropped; boundary and interfaces
+    /// kept). The replaced tets are reported by their input index.
+    #[arg(long)]
+    allow_shell_changes: bool,
     /// Growth of the shell-derived size per unit distance (without --size).
     #[arg(long, value_name = "G", default_value_t = 0.3)]
     grading: f64,
@@ -182,7 +188,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
         Ok(z)
     };
     let mut progress = |s: &str| stage.set(s.to_string());
-    let (out, report, what): (TetMesh, RemeshReport, _) = match &a.insert {
+    let (mut out, mut report, what): (TetMesh, RemeshReport, _) = match &a.insert {
         None => {
             let (out, report) = remesh(&mesh, &zone, &sizing, &opts, &mut progress)
                 .with_context(|| format!("{name}: cannot remesh"))?;
@@ -210,6 +216,10 @@ pub fn run(a: Args) -> Result<ExitCode> {
             (out, report, what)
         }
     };
+    if a.allow_shell_changes {
+        stage.set("sliver removal across the shell");
+        out = across_shell(&out, &mut report, &opts.improve.unwrap_or_default());
+    }
     stage.set("measuring");
     let new_tets = TetMesh {
         points: out.points.clone(),
@@ -250,6 +260,17 @@ pub fn run(a: Args) -> Result<ExitCode> {
                 c.shell_triangles,
                 c.points_added,
                 c.pipeline.seconds_total
+            );
+        }
+        if let Some(c) = &report.shell_changes {
+            text += &format!(
+                "  across the shell: {} of {} kept tets around the zone replaced by sliver removal \
+                 ({} → {} tets there, {:.3} s)\n",
+                c.kept_replaced.len(),
+                c.kept_offered,
+                c.tets_before,
+                c.tets_after,
+                c.seconds
             );
         }
         if let Some(l) = a.label.filter(|_| a.insert.is_some()) {

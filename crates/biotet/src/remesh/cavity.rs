@@ -305,6 +305,8 @@ pub(super) fn replace(
         seconds_select,
         seconds_splice: clock.elapsed().as_secs_f64(),
         seconds_total: start.elapsed().as_secs_f64(),
+        shell_changes: None,
+        kept_input: (0..nt as u32).filter(|&t| !carved[t as usize]).collect(),
     };
     Ok((out, report))
 }

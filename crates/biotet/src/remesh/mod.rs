@@ -13,9 +13,11 @@
 
 mod cavity;
 mod insert;
+mod shell;
 mod zone;
 
 pub use insert::insert;
+pub use shell::{ShellChanges, across_shell};
 
 use crate::mesh::surface::SurfaceMesh;
 use crate::mesh::tet::TetMesh;
@@ -191,6 +193,11 @@ pub struct RemeshReport {
     pub seconds_splice: f64,
     /// Seconds in all.
     pub seconds_total: f64,
+    /// With `--allow-shell-changes` ([`across_shell`]): the kept tets sliver removal replaced.
+    pub shell_changes: Option<ShellChanges>,
+    /// The input index of each kept tet (the first `tets_kept` of the output).
+    #[serde(skip)]
+    pub kept_input: Vec<u32>,
 }
 
 /// Replace the tets of `zone` (see the module docs). `sizing` builds the size function on each

@@ -13,6 +13,11 @@ use std::collections::BTreeSet;
 /// A ball of radius 4 with a ball of radius 1.5 inside (regions 2 inside, 1 around), meshed at
 /// size 0.6.
 fn nested() -> (SurfaceMesh, TetMesh) {
+    nested_with(&PipelineOptions::default())
+}
+
+/// [`nested`] meshed with `opts`.
+fn nested_with(opts: &PipelineOptions) -> (SurfaceMesh, TetMesh) {
     let parts = vec![
         Part {
             surface: SurfaceMesh::icosphere(4.0, 3),
@@ -25,13 +30,7 @@ fn nested() -> (SurfaceMesh, TetMesh) {
     ];
     let (mut s, _) = assemble(parts).unwrap();
     validate_surface(&mut s, &ValidateOptions::default()).unwrap();
-    let (m, _) = mesh_surface(
-        &s,
-        Sizing::uniform(0.6).unwrap(),
-        &PipelineOptions::default(),
-        &mut |_| {},
-    )
-    .unwrap();
+    let (m, _) = mesh_surface(&s, Sizing::uniform(0.6).unwrap(), opts, &mut |_| {}).unwrap();
     (s, m)
 }
 
@@ -159,6 +158,56 @@ fn a_ball_far_finer_than_its_shell() {
     assert_in_place(&s, &m, &out, r.tets_kept, changed);
     let removed = m.tets.len() - r.tets_kept;
     assert!(changed > 20 * removed, "{removed} → {changed}");
+}
+
+/// `--allow-shell-changes`: sliver removal across the shell replaces some kept tets around the
+/// zone, reports each by its input index, keeps every other kept tet and the volumes, and leaves
+/// no more tets under 10° than the refill alone. The input is made without sliver removal,
+/// smoothing or polishing, so the kept tets around the zone hold slivers to replace.
+#[test]
+fn sliver_removal_across_the_shell_reports_what_it_changed() {
+    let (s, m) = nested_with(&PipelineOptions {
+        improve: None,
+        smooth: None,
+        polish: None,
+        ..PipelineOptions::default()
+    });
+    let zone = Zone::Sphere {
+        centre: [2.7, 0.0, 0.0],
+        radius: 0.9,
+    };
+    let (alone, r0) = run(&m, zone, 1.5);
+    let mut r = r0.clone();
+    let out =
+        biotet::remesh::across_shell(&alone, &mut r, &PipelineOptions::default().improve.unwrap());
+    let c = r.shell_changes.as_ref().unwrap();
+    assert!(!c.kept_replaced.is_empty() && c.kept_replaced.len() <= c.kept_offered);
+    assert!(c.improve.n_bad_after < c.improve.n_bad_before);
+    assert_in_place(&s, &m, &out, r.tets_kept, out.tets.len() - r.tets_kept);
+    assert_eq!(r.kept_input.len(), r.tets_kept);
+    // The kept tets are the input's, index for index; the replaced ones are gone.
+    let key = |mesh: &TetMesh, t: usize| {
+        let mut c = mesh.tets[t].map(|v| mesh.points[v as usize].map(f64::to_bits));
+        c.sort();
+        (c, mesh.labels[t])
+    };
+    for (i, &t) in r.kept_input.iter().enumerate() {
+        assert_eq!(key(&out, i), key(&m, t as usize));
+    }
+    let all = tet_set(&out, 0..out.tets.len());
+    for &t in &c.kept_replaced {
+        assert!(
+            !all.contains(&key(&m, t as usize)),
+            "kept tet {t} still there"
+        );
+    }
+    let below = |mesh: &TetMesh| QualityReport::of(mesh).n_dihedral_lt_10;
+    assert!(
+        below(&out) <= below(&alone),
+        "{} > {}",
+        below(&out),
+        below(&alone)
+    );
 }
 
 #[test]
