@@ -8,7 +8,8 @@
 On the nested brain/white-matter model meshed with defaults (and, unless --skip-fine, at --fine-size, above 1M
 tets): the white matter (region 2) at half and twice its median edge length, a 20 mm ball in the grey matter at a
 third of it, a 10 mm ellipsoid lesion inserted inside the grey matter (label 3) and one across the grey/white
-interface (refused: crossing is not handled yet), and a ball holding about 1% of the tets refilled at the grey
+interface (refused: crossing is not handled yet), the 20 mm ball again with --allow-shell-changes, a 16 mm ball at a
+sixth of the grey matter's size (far finer than its shell), and a ball holding about 1% of the tets refilled at the grey
 matter's size (the cost against meshing the whole model). For each: seconds (median of --repeat runs of the library's
 `seconds_total`, reading and writing aside), tets removed and added, the new tets' and the whole mesh's dihedral
 angles, and `biotet check` against the model's surface (and the lesion's).
@@ -252,6 +253,12 @@ def bench_mesh(exe, mmg, tmp, name, mesh_args, repeat, own_size):
         ("white matter at twice its size", ["--region", "2", "--size", f"{2 * h:.4g}"], 2 * h, None),
         ("20 mm ball in grey matter, a third of the size",
          ["--sphere", ",".join(f"{x:.4g}" for x in spot) + ",10", "--size", f"{hg / 3:.4g}"], hg / 3, None),
+        ("the same ball, sliver removal across its shell",
+         ["--sphere", ",".join(f"{x:.4g}" for x in spot) + ",10", "--size", f"{hg / 3:.4g}",
+          "--allow-shell-changes"], None, None),
+        # A refill six times finer than the shell's triangles (recovery failed here before 2026-12-02).
+        ("16 mm ball in grey matter, a sixth of the size",
+         ["--sphere", ",".join(f"{x:.4g}" for x in spot) + ",8", "--size", f"{hg / 6:.4g}"], hg / 6, None),
         # Sizes from the cavity's surface (the lesion's edges and the shell's): a uniform size far above the
         # lesion's edges leaves poor tets at it.
         ("10 mm ellipsoid lesion inside grey matter",
