@@ -32,7 +32,9 @@ use crate::lastresort::Searcher;
 use crate::mesh::tet::{NO_NEIGHBOR, TET_EDGES};
 use crate::quality::tet::{dihedral_angles, min_dihedral_chord2};
 
-use super::refill::{RefillParams, every_face_has_candidate, faces_without_candidate, judge};
+use super::refill::{
+    Judge, RefillParams, every_face_has_candidate, faces_without_candidate, judge,
+};
 use super::relocate::StepParams;
 use super::work::{Cavity, P3, Work};
 
@@ -158,7 +160,7 @@ impl Work {
         if !x.iter().all(|&v| in_exact_range(v)) || !self.strictly_inside(&cav.tets, x) {
             return None;
         }
-        let old = judge(self, &cav.tets, thr);
+        let old = judge(self, &cav.tets, thr, Judge::MinAngle);
         let p = self.pts.len() as u32;
         let mut cands: Vec<u32> = on_shell.iter().copied().chain([p]).collect();
         cands.sort_unstable();
@@ -187,7 +189,7 @@ impl Work {
             self.fixed.push(false);
             let old_tets: Vec<[u32; 4]> = cav.tets.iter().map(|&s| self.tets[s as usize]).collect();
             let ids = self.replace(&cav, &f.tets);
-            let new = judge(self, &ids, thr);
+            let new = judge(self, &ids, thr, Judge::MinAngle);
             if new.0 > old.0 && new.1 >= old.1 && new.2 < old.2 {
                 out = Some(ids);
             } else {
@@ -249,7 +251,7 @@ impl Work {
         let large = tets.len() > 5;
         let (cav, on_shell) = self.cavity_of_shell_points(tets)?;
         let (x, cone_ok) = self.best_point(t, &cav.tets, &cav.shell, thr)?;
-        let old = judge(self, &cav.tets, thr);
+        let old = judge(self, &cav.tets, thr, Judge::MinAngle);
         let old_tets: Vec<[u32; 4]> = cav.tets.iter().map(|&s| self.tets[s as usize]).collect();
         let p = self.pts.len() as u32;
         self.pts.push(x);
@@ -261,7 +263,7 @@ impl Work {
             let cone: Vec<[u32; 4]> = cav.shell.iter().map(|f| [f[0], f[1], f[2], p]).collect();
             let ids = self.replace(&cav, &cone);
             self.relocate(p, thr.to_radians(), sp, star);
-            let new = judge(self, &ids, thr);
+            let new = judge(self, &ids, thr, Judge::MinAngle);
             (ids, new)
         } else {
             (
@@ -291,7 +293,7 @@ impl Work {
                 if let Ok(f) = r {
                     let cur = self.cavity(ids);
                     ids = self.replace(&cur, &f.tets);
-                    new = judge(self, &ids, thr);
+                    new = judge(self, &ids, thr, Judge::MinAngle);
                     filled = true;
                     break;
                 }

@@ -15,6 +15,10 @@
 //! the stars of that edge's ends refilled (`insert`); then a round of moves around the tets
 //! still bad (the new points move too).
 //!
+//! Last, the **obtuse** step: an unforced tet whose largest dihedral angle is above
+//! [`PolishOptions::max_deg`] (its smallest already at or above the threshold) is refilled with
+//! its face neighbours, or an interior corner's star refilled without it (`obtuse`).
+//!
 //! Surface points (on a boundary or interface face) never move and are never removed, and no
 //! point is added on a boundary or interface face; every accepted change keeps every tet strictly
 //! positive (exact `orient3d`) and never lowers a forced tet below its angle before or the
@@ -22,6 +26,7 @@
 //! threads.
 
 mod insert;
+mod obtuse;
 mod refill;
 mod relocate;
 mod work;
@@ -36,7 +41,7 @@ use rustc_hash::FxHashSet;
 use crate::lastresort::Searcher;
 use crate::mesh::tet::{NO_NEIGHBOR, TetMesh};
 use crate::quality::tet::min_dihedral_chord2;
-use refill::RefillParams;
+use refill::{Judge, RefillParams};
 use relocate::StepParams;
 use work::Work;
 
@@ -67,6 +72,9 @@ pub struct PolishOptions {
     /// Where the one-point insertion fails on a wedge (one small angle opposite a short edge),
     /// try a point in front of the short edge with the stars of its ends refilled.
     pub wedge: bool,
+    /// Unforced tets whose largest dihedral angle is above this many degrees (their smallest
+    /// at or above the threshold) get a last step (see the `obtuse` module); 180 turns it off.
+    pub max_deg: f64,
     /// Let the wedge step also search fills above the cavity's worst tet, not only above the
     /// threshold: on brain_20k 7 wedges fixed instead of 3, at 0.07 s (0.5 s on the nested
     /// model). Off by default: the pipeline's time is worth more than those few tets.
@@ -85,6 +93,7 @@ impl Default for PolishOptions {
             insert: true,
             insert_rounds: 3,
             wedge: true,
+            max_deg: 165.0,
             wedge_lower_floor: false,
         }
     }
@@ -123,11 +132,16 @@ pub struct PolishReport {
     /// The unforced tets still below the threshold by how many interior (movable) corners they
     /// have: `[0, 1, 2, 3, 4]`.
     pub bad_by_interior_corners: [usize; 5],
+    /// Unforced tets above [`PolishOptions::max_deg`] (and at or above the threshold) before
+    /// the obtuse step.
+    pub n_obtuse_before: usize,
+    /// Those left after it.
+    pub n_obtuse_after: usize,
     /// Smallest dihedral angle of an unforced tet after, degrees.
     pub min_unforced_deg: Option<f64>,
-    /// Milliseconds spent: `[scan, moves, removals, refills, inserts]` (the last with the
-    /// round of moves after them).
-    pub ms: [f64; 5],
+    /// Milliseconds spent: `[scan, moves, removals, refills, inserts, obtuse]` (inserts with
+    /// the round of moves after them).
+    pub ms: [f64; 6],
     /// Wall seconds.
     pub seconds: f64,
 }
@@ -188,7 +202,15 @@ pub fn polish(mesh: &mut TetMesh, opts: &PolishOptions) -> PolishReport {
                 w.star(v, &mut star);
                 report.removals_tried += 1;
                 let c = Instant::now();
-                let r = w.refill(&mut searcher, star.clone(), Some(v), true, thr, &rp);
+                let r = w.refill(
+                    &mut searcher,
+                    star.clone(),
+                    Some(v),
+                    true,
+                    thr,
+                    &rp,
+                    Judge::MinAngle,
+                );
                 report.ms[2] += c.elapsed().as_secs_f64() * 1e3;
                 if let Some(ids) = r {
                     report.removals_accepted += 1;
@@ -244,6 +266,18 @@ pub fn polish(mesh: &mut TetMesh, opts: &PolishOptions) -> PolishReport {
         }
         report.ms[4] = c.elapsed().as_secs_f64() * 1e3;
     }
+    if opts.max_deg < 180.0 {
+        let c = Instant::now();
+        let (before, after, changed) =
+            obtuse::run(&mut w, thr, opts.max_deg, &mut searcher, &mut star);
+        report.n_obtuse_before = before;
+        report.n_obtuse_after = after;
+        report.ms[5] = c.elapsed().as_secs_f64() * 1e3;
+        // A refill never adds a tet below the threshold, but may replace one: recount.
+        if changed {
+            bad = scan_all(&mut w, thr);
+        }
+    }
     report.n_bad_after = bad.len();
     report.bad_by_interior_corners = by_interior_corners(&w, &bad);
     report.min_unforced_deg = bad.first().map(|x| x.0);
@@ -279,7 +313,7 @@ fn try_refill(
     cav.dedup();
     report.refills_tried += 1;
     let c = Instant::now();
-    let r = w.refill(searcher, cav, None, false, thr, rp);
+    let r = w.refill(searcher, cav, None, false, thr, rp, Judge::MinAngle);
     report.ms[3] += c.elapsed().as_secs_f64() * 1e3;
     if let Some(ids) = r {
         report.refills_accepted += 1;

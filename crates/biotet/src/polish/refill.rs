@@ -37,11 +37,27 @@ impl RefillParams {
     }
 }
 
-/// The unforced worst angle, overall worst angle and count below `thr` of `tets`.
-pub(super) fn judge(w: &mut Work, tets: &[u32], thr: f64) -> (f64, f64, usize) {
+/// What a refill must improve.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Judge {
+    /// The smallest dihedral angle.
+    MinAngle,
+    /// The smallest dihedral angle and, measured as its distance below `max_deg` added to the
+    /// threshold, the largest: a tet at 10.2° and 165.6° counts as 9.4° against 10° and 165°.
+    Range {
+        /// The largest dihedral angle wanted, degrees.
+        max_deg: f64,
+    },
+}
+
+/// The unforced worst measure, overall worst measure and count below `thr` of `tets`.
+pub(super) fn judge(w: &mut Work, tets: &[u32], thr: f64, by: Judge) -> (f64, f64, usize) {
     let (mut unforced, mut all, mut below) = (f64::INFINITY, f64::INFINITY, 0);
     for &t in tets {
-        let a = w.min_angle(t);
+        let a = match by {
+            Judge::MinAngle => w.min_angle(t),
+            Judge::Range { max_deg } => w.min_angle(t).min(thr + max_deg - w.max_angle(t)),
+        };
         all = all.min(a);
         below += usize::from(a < thr);
         if !w.is_forced(t) {
@@ -98,8 +114,9 @@ pub(super) fn faces_without_candidate(
 
 impl Work {
     /// Refill the cavity of `tets` (one label), without point `drop` if given; the new tets when
-    /// accepted. With `perfect_only`, only fills whose every tet is above the threshold are
-    /// searched.
+    /// accepted (better by `by`). With `perfect_only`, only fills whose every tet is above the
+    /// threshold are searched.
+    #[allow(clippy::too_many_arguments)]
     pub fn refill(
         &mut self,
         searcher: &mut Searcher,
@@ -108,6 +125,7 @@ impl Work {
         perfect_only: bool,
         thr: f64,
         p: &RefillParams,
+        by: Judge,
     ) -> Option<Vec<u32>> {
         if tets.len() > p.max_tets {
             return None;
@@ -116,7 +134,7 @@ impl Work {
         if tets.iter().any(|&t| self.labels[t as usize] != label) {
             return None;
         }
-        let old = judge(self, &tets, thr);
+        let old = judge(self, &tets, thr, by);
         let cav = self.cavity(tets);
         let on_shell: FxHashSet<u32> = cav.shell.iter().flatten().copied().collect();
         if drop.is_some_and(|v| on_shell.contains(&v)) {
@@ -156,7 +174,7 @@ impl Work {
         let fill = fill?;
         let old_tets: Vec<[u32; 4]> = cav.tets.iter().map(|&t| self.tets[t as usize]).collect();
         let ids = self.replace(&cav, &fill.tets);
-        let new = judge(self, &ids, thr);
+        let new = judge(self, &ids, thr, by);
         if new.0 > old.0 && new.1 >= old.1 && new.2 <= old.2 {
             return Some(ids);
         }

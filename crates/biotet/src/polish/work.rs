@@ -122,6 +122,14 @@ impl Work {
         min_deg(&self.corners(t))
     }
 
+    /// The largest dihedral angle of tet `t`, degrees.
+    pub fn max_angle(&self, t: u32) -> f64 {
+        crate::quality::tet::dihedral_angles(&self.corners(t))
+            .into_iter()
+            .fold(0.0, f64::max)
+            .to_degrees()
+    }
+
     /// Every live tet with corner `v`, across the faces around `v` (all labels).
     pub fn star(&self, v: u32, out: &mut Vec<u32>) {
         out.clear();

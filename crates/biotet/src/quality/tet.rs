@@ -64,6 +64,25 @@ pub fn min_dihedral_chord2(c: &[[f64; 3]; 4]) -> f64 {
     worst
 }
 
+/// `4·sin²(θ/2)` of the largest interior dihedral angle θ (as [`min_dihedral_chord2`] for the
+/// smallest): a cheap screen for tets above an angle. 4 for a degenerate tet.
+pub fn max_dihedral_chord2(c: &[[f64; 3]; 4]) -> f64 {
+    let n = face_normals(c);
+    let mut u = [[0.0; 3]; 4];
+    for (ui, ni) in u.iter_mut().zip(&n) {
+        let l = norm(*ni);
+        if l == 0.0 {
+            return 4.0;
+        }
+        *ui = scale(*ni, 1.0 / l);
+    }
+    let mut worst: f64 = 0.0;
+    for [k, l] in TET_EDGES {
+        worst = worst.max(norm2(add(u[k], u[l])));
+    }
+    worst
+}
+
 /// The smallest interior dihedral angle in degrees, from [`min_dihedral_chord2`]: one `asin`
 /// instead of six `atan2`, for code that ranks many tets (0 for a degenerate tet). It may differ
 /// from [`min_dihedral_deg`] in the last bits.

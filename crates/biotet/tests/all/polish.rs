@@ -230,3 +230,50 @@ fn polish_fixes_wedges_at_short_edges_of_the_tetgen_brain_mesh() {
     let c = check(&on, Some(&surface));
     assert!(c.valid, "{c}");
 }
+
+/// The obtuse step: on TetGen's brain mesh, polishing with the 165° cap leaves fewer unforced
+/// tets whose largest dihedral angle is above 165° (and smallest at or above 10°) than polishing
+/// without it, adds no tet below 10°, and keeps the mesh valid.
+#[test]
+fn polish_refills_tets_above_165_degrees() {
+    let surface = load_stl("brain_20k.stl");
+    let obtuse = |m: &TetMesh| {
+        let f = classify(m, &surface, 10.0);
+        (0..m.tets.len())
+            .filter(|&t| {
+                let a = dihedral_angles(&m.corners(t)).map(f64::to_degrees);
+                !f.forced[t]
+                    && a.iter().copied().fold(0.0, f64::max) > 165.0
+                    && a.iter().copied().fold(f64::INFINITY, f64::min) >= 10.0
+            })
+            .count()
+    };
+    let below = |m: &TetMesh| (0..m.tets.len()).filter(|&t| min_deg(m, t) < 10.0).count();
+    let mut off = tetgen_brain();
+    let r_off = polish(
+        &mut off,
+        &PolishOptions {
+            max_deg: 180.0,
+            ..PolishOptions::default()
+        },
+    );
+    let mut on = tetgen_brain();
+    let r_on = polish(&mut on, &PolishOptions::default());
+    assert_eq!(r_off.n_obtuse_before, 0);
+    assert!(r_on.n_obtuse_before > 0, "{r_on:?}");
+    assert!(r_on.n_obtuse_after < r_on.n_obtuse_before, "{r_on:?}");
+    assert!(
+        obtuse(&on) < obtuse(&off),
+        "{} vs {}",
+        obtuse(&on),
+        obtuse(&off)
+    );
+    assert!(
+        below(&on) <= below(&off),
+        "{} vs {}",
+        below(&on),
+        below(&off)
+    );
+    let c = check(&on, Some(&surface));
+    assert!(c.valid, "{c}");
+}
