@@ -1559,13 +1559,19 @@ fn a_region_pinched_at_an_edge_is_refused_naming_the_edge() {
     }
 }
 
+/// trimesh's icosphere and its mesh (defaults) written into `dir`: (surface, mesh).
+fn meshed_icosphere(dir: &Path) -> (PathBuf, PathBuf) {
+    let surface = root().join("tests/data/shapes/tm_icosphere.off");
+    let base = dir.join("base.vtu");
+    let out = biotet(&["mesh", s(&surface), "-o", s(&base), "--quiet"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    (surface, base)
+}
+
 #[test]
 fn remesh_replaces_a_zone_keeps_the_rest_and_refuses_a_missing_zone() {
     let dir = tempfile::tempdir().unwrap();
-    let surface = root().join("tests/data/shapes/tm_icosphere.off");
-    let base = dir.path().join("base.vtu");
-    let out = biotet(&["mesh", s(&surface), "-o", s(&base), "--quiet"]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    let (surface, base) = meshed_icosphere(dir.path());
     let before = json_of(&biotet(&["quality", s(&base), "--json"]));
     // A ball and a box (negative coordinates without '=') at a finer size.
     for zone in [
@@ -1656,10 +1662,7 @@ fn size_vti(path: &std::path::Path, f: impl Fn(f64) -> f64) {
 #[test]
 fn remesh_takes_a_size_field_and_allows_shell_changes() {
     let dir = tempfile::tempdir().unwrap();
-    let surface = root().join("tests/data/shapes/tm_icosphere.off");
-    let base = dir.path().join("base.vtu");
-    let out = biotet(&["mesh", s(&surface), "-o", s(&base), "--quiet"]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    let (surface, base) = meshed_icosphere(dir.path());
     let added = |args: &[&str]| {
         let new = dir.path().join("new.vtu");
         let mut a = vec!["remesh", s(&base), "--region", "1", "-o", s(&new), "--json"];
@@ -1741,10 +1744,7 @@ fn ellipsoid_off(c: [f64; 3], r: [f64; 3]) -> String {
 #[test]
 fn remesh_insert_embeds_a_surface_and_refuses_one_crossing_the_boundary() {
     let dir = tempfile::tempdir().unwrap();
-    let surface = root().join("tests/data/shapes/tm_icosphere.off");
-    let base = dir.path().join("base.vtu");
-    let out = biotet(&["mesh", s(&surface), "-o", s(&base), "--quiet"]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    let (surface, base) = meshed_icosphere(dir.path());
     let lesion = dir.path().join("lesion.off");
     std::fs::write(&lesion, ellipsoid_off([0.2, 0.1, 0.0], [0.35, 0.2, 0.25])).unwrap();
     let new = dir.path().join("new.vtu");

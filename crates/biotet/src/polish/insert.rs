@@ -51,13 +51,7 @@ impl Work {
         star: &mut Vec<u32>,
     ) -> Option<Vec<u32>> {
         let label = self.labels[t as usize];
-        let mut faces = vec![t];
-        for n in self.nb[t as usize] {
-            if n != NO_NEIGHBOR && self.labels[n as usize] == label && !self.is_forced(n) {
-                faces.push(n);
-            }
-        }
-        faces.sort_unstable();
+        let faces = self.with_face_neighbours(t);
         if let Some(ids) = self.insert_into(t, faces.clone(), thr, searcher, rp, sp, star) {
             return Some(ids);
         }

@@ -301,16 +301,7 @@ fn try_refill(
 ) -> bool {
     // The tet and its face neighbours, refilled with the moved points (larger cavities,
     // such as every tet sharing a corner, cost thirty times more for a third more).
-    let mut cav = Vec::new();
-    let label = w.labels[t as usize];
-    cav.push(t);
-    for n in w.nb[t as usize] {
-        if n != NO_NEIGHBOR && w.labels[n as usize] == label && !w.is_forced(n) {
-            cav.push(n);
-        }
-    }
-    cav.sort_unstable();
-    cav.dedup();
+    let cav = w.with_face_neighbours(t);
     report.refills_tried += 1;
     let c = Instant::now();
     let r = w.refill(searcher, cav, None, false, thr, rp, Judge::MinAngle);

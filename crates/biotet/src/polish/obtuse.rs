@@ -11,7 +11,6 @@
 use rayon::prelude::*;
 
 use crate::lastresort::Searcher;
-use crate::mesh::tet::NO_NEIGHBOR;
 use crate::quality::tet::max_dihedral_chord2;
 
 use super::refill::{Judge, RefillParams};
@@ -41,15 +40,7 @@ pub(super) fn run(
         if !w.alive[t as usize] || w.is_forced(t) || w.max_angle(t) <= max_deg {
             continue;
         }
-        let label = w.labels[t as usize];
-        let mut cav = vec![t];
-        for n in w.nb[t as usize] {
-            if n != NO_NEIGHBOR && w.labels[n as usize] == label && !w.is_forced(n) {
-                cav.push(n);
-            }
-        }
-        cav.sort_unstable();
-        cav.dedup();
+        let cav = w.with_face_neighbours(t);
         if let Some(ids) = w.refill(searcher, cav, None, false, thr, &PARAMS, by) {
             check.extend(ids);
             continue;

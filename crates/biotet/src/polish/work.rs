@@ -122,6 +122,20 @@ impl Work {
         min_deg(&self.corners(t))
     }
 
+    /// Tet `t` and its unforced face neighbours of its label, sorted.
+    pub fn with_face_neighbours(&mut self, t: u32) -> Vec<u32> {
+        let label = self.labels[t as usize];
+        let mut out = vec![t];
+        for n in self.nb[t as usize] {
+            if n != NO_NEIGHBOR && self.labels[n as usize] == label && !self.is_forced(n) {
+                out.push(n);
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
     /// The largest dihedral angle of tet `t`, degrees.
     pub fn max_angle(&self, t: u32) -> f64 {
         crate::quality::tet::dihedral_angles(&self.corners(t))

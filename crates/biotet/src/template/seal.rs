@@ -177,34 +177,50 @@ fn circumsphere(p: [[f64; 3]; 3]) -> Option<([f64; 3], f64)> {
     Some((add(p[0], r), norm(r)))
 }
 
-/// The unprocessed voxels strictly inside the ball of centre `c` and radius `r` (appended to
-/// `out`).
-fn ball_voxels(t: &Template, c: [f64; 3], r: f64, out: &mut Vec<usize>) {
+/// The unprocessed voxels in the box `lo..hi` whose centre passes `keep` (appended to `out`).
+fn box_voxels(
+    t: &Template,
+    lo: [f64; 3],
+    hi: [f64; 3],
+    keep: impl Fn([f64; 3]) -> bool,
+    out: &mut Vec<usize>,
+) {
     let inv = 1.0 / t.dx;
     let span = |a: usize| {
-        let l = ((c[a] - r - t.origin[a]) * inv).ceil().max(0.0) as usize;
-        let h = ((c[a] + r - t.origin[a]) * inv).floor();
+        let l = ((lo[a] - t.origin[a]) * inv).ceil().max(0.0) as usize;
+        let h = ((hi[a] - t.origin[a]) * inv).floor();
         (l, (h >= 0.0).then(|| (h as usize).min(t.n[a] - 1)))
     };
     let ((i0, Some(i1)), (j0, Some(j1)), (k0, Some(k1))) = (span(0), span(1), span(2)) else {
         return;
     };
-    let r2 = r * r;
     for k in k0..=k1 {
         for j in j0..=j1 {
             let row = t.index(0, j, k);
             for i in i0..=i1 {
                 let idx = row + i;
-                if t.state(idx) != UNPROCESSED {
-                    continue;
-                }
-                let d = sub(t.point([i, j, k]), c);
-                if dot(d, d) < r2 {
+                if t.state(idx) == UNPROCESSED && keep(t.point([i, j, k])) {
                     out.push(idx);
                 }
             }
         }
     }
+}
+
+/// The unprocessed voxels strictly inside the ball of centre `c` and radius `r` (appended to
+/// `out`).
+fn ball_voxels(t: &Template, c: [f64; 3], r: f64, out: &mut Vec<usize>) {
+    let r2 = r * r;
+    box_voxels(
+        t,
+        c.map(|x| x - r),
+        c.map(|x| x + r),
+        |x| {
+            let d = sub(x, c);
+            dot(d, d) < r2
+        },
+        out,
+    );
 }
 
 /// The unit normal pointing into the meshed side of a triangle whose other side is the outside
@@ -310,34 +326,19 @@ fn cap_voxels(t: &Template, c: [f64; 3], r: f64, h: f64, inward: [f64; 3], out: 
     let big = d + h;
     let centre = add(c, scale(inward, -d));
     let top = add(c, scale(inward, h));
-    let inv = 1.0 / t.dx;
-    let span = |a: usize| {
-        let lo = c[a].min(top[a]) - r;
-        let hi = c[a].max(top[a]) + r;
-        let l = ((lo - t.origin[a]) * inv).ceil().max(0.0) as usize;
-        let u = ((hi - t.origin[a]) * inv).floor();
-        (l, (u >= 0.0).then(|| (u as usize).min(t.n[a] - 1)))
-    };
-    let ((i0, Some(i1)), (j0, Some(j1)), (k0, Some(k1))) = (span(0), span(1), span(2)) else {
-        return;
-    };
+    let lo = [0, 1, 2].map(|a| c[a].min(top[a]) - r);
+    let hi = [0, 1, 2].map(|a| c[a].max(top[a]) + r);
     let big2 = big * big;
-    for k in k0..=k1 {
-        for j in j0..=j1 {
-            let row = t.index(0, j, k);
-            for i in i0..=i1 {
-                let idx = row + i;
-                if t.state(idx) != UNPROCESSED {
-                    continue;
-                }
-                let x = t.point([i, j, k]);
-                let e = sub(x, centre);
-                if dot(sub(x, c), inward) > 0.0 && dot(e, e) < big2 {
-                    out.push(idx);
-                }
-            }
-        }
-    }
+    box_voxels(
+        t,
+        lo,
+        hi,
+        |x| {
+            let e = sub(x, centre);
+            dot(sub(x, c), inward) > 0.0 && dot(e, e) < big2
+        },
+        out,
+    );
 }
 
 /// The unprocessed voxels strictly inside the prism over triangle `q` (mid-plane) with normal
@@ -353,23 +354,6 @@ fn prism_voxels(t: &Template, q: [[f64; 3]; 3], h: [f64; 3], n: [f64; 3], out: &
             hi[a] = hi[a].max(c[a] + e);
         }
     }
-    let inv = 1.0 / t.dx;
-    let span = |a: usize| {
-        let l = ((lo[a] - t.origin[a]) * inv).ceil().max(0.0) as usize;
-        let h = ((hi[a] - t.origin[a]) * inv).floor();
-        let h = if h < 0.0 {
-            None
-        } else {
-            Some((h as usize).min(t.n[a] - 1))
-        };
-        (l, h)
-    };
-    let (i0, i1) = span(0);
-    let (j0, j1) = span(1);
-    let (k0, k1) = span(2);
-    let (Some(i1), Some(j1), Some(k1)) = (i1, j1, k1) else {
-        return;
-    };
     // Barycentric coordinates in the plane: solve with the 2×2 Gram system of the two edges.
     let e1 = sub(q[1], q[0]);
     let e2 = sub(q[2], q[0]);
@@ -379,29 +363,19 @@ fn prism_voxels(t: &Template, q: [[f64; 3]; 3], h: [f64; 3], n: [f64; 3], out: &
         return;
     }
     let inv_det = 1.0 / det;
-    for k in k0..=k1 {
-        for j in j0..=j1 {
-            let row = t.index(0, j, k);
-            for i in i0..=i1 {
-                let idx = row + i;
-                if t.state(idx) != UNPROCESSED {
-                    continue;
-                }
-                let x = t.point([i, j, k]);
-                let r = sub(x, q[0]);
-                let dist = dot(r, n);
-                let (b1, b2) = (dot(r, e1), dot(r, e2));
-                let l1 = (a22 * b1 - a12 * b2) * inv_det;
-                let l2 = (a11 * b2 - a12 * b1) * inv_det;
-                let l0 = 1.0 - l1 - l2;
-                if l0 < 0.0 || l1 < 0.0 || l2 < 0.0 {
-                    continue;
-                }
-                let height = l0 * h[0] + l1 * h[1] + l2 * h[2];
-                if dist.abs() < height {
-                    out.push(idx);
-                }
-            }
-        }
-    }
+    box_voxels(
+        t,
+        lo,
+        hi,
+        |x| {
+            let r = sub(x, q[0]);
+            let dist = dot(r, n);
+            let (b1, b2) = (dot(r, e1), dot(r, e2));
+            let l1 = (a22 * b1 - a12 * b2) * inv_det;
+            let l2 = (a11 * b2 - a12 * b1) * inv_det;
+            let l0 = 1.0 - l1 - l2;
+            l0 >= 0.0 && l1 >= 0.0 && l2 >= 0.0 && dist.abs() < l0 * h[0] + l1 * h[1] + l2 * h[2]
+        },
+        out,
+    );
 }
