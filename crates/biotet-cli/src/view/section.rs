@@ -172,7 +172,11 @@ pub fn cut(
         let c = tet.map(|x| mesh.points[x as usize]);
         let s = c.map(|p| plane.side(p));
         let (neg, pos) = (s.iter().any(|&x| x < 0.0), s.iter().any(|&x| x > 0.0));
-        if !(neg && pos) {
+        // A tet with a face in the plane shows that face, drawn once: by the tet on the plane's
+        // positive side (a plane through a grid of faces, x = 20 on a 1 mm image's mesh, would
+        // otherwise leave holes).
+        let on = s.iter().filter(|&&x| x == 0.0).count();
+        if !(neg && pos) && !(pos && on == 3) {
             continue;
         }
         let pts = cut_points(plane, &c, &s, &TET_EDGES);
