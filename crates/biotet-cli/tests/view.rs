@@ -6,45 +6,52 @@ use std::fmt::Write as _;
 use std::path::Path;
 use support::*;
 
-/// The cube [0, 2]³ as its six Kuhn tets (around the diagonal from the origin), the three
-/// whose path leaves the origin along x in region 1 and the others in region 7, as Medit text.
-fn kuhn_cube() -> String {
-    let p = |b: usize| {
+/// `cubes` Kuhn cubes of side 2 stacked along z (points shared between them), as Medit text:
+/// each cube's six tets around the diagonal from its lowest corner, positively oriented,
+/// labelled by `label(path start)` (the axis bit, 1, 2 or 4, its path leaves that corner along).
+fn kuhn_cubes(cubes: usize, label: impl Fn(usize) -> u32) -> String {
+    // Corner b (bits x, y, z) of cube i: layer i + (b >> 2), index b & 3 in it.
+    let layer_point = |b: usize, layer: usize| {
         [
             (b & 1) as f64 * 2.0,
             (b >> 1 & 1) as f64 * 2.0,
-            (b >> 2 & 1) as f64 * 2.0,
+            layer as f64 * 2.0,
         ]
     };
-    let mut s = String::from("MeshVersionFormatted 2\nDimension 3\nVertices\n8\n");
-    for b in 0..8 {
-        let q = p(b);
-        writeln!(s, "{} {} {} 0", q[0], q[1], q[2]).unwrap();
-    }
-    s.push_str("Tetrahedra\n6\n");
-    for (a, b) in [(1, 2), (1, 4), (2, 1), (2, 4), (4, 1), (4, 2)] {
-        let mut t = [0usize, a, a | b, 7];
-        let c = t.map(p);
-        let d = |i: usize| [0, 1, 2].map(|k| c[i][k] - c[0][k]);
-        let (u, v, w) = (d(1), d(2), d(3));
-        let det = u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0])
-            + u[2] * (v[0] * w[1] - v[1] * w[0]);
-        if det < 0.0 {
-            t.swap(1, 2);
+    let mut s = format!(
+        "MeshVersionFormatted 2\nDimension 3\nVertices\n{}\n",
+        4 * (cubes + 1)
+    );
+    for layer in 0..=cubes {
+        for b in 0..4 {
+            let q = layer_point(b, layer);
+            writeln!(s, "{} {} {} 0", q[0], q[1], q[2]).unwrap();
         }
-        let label = if a == 1 { 1 } else { 7 };
-        writeln!(
-            s,
-            "{} {} {} {} {label}",
-            t[0] + 1,
-            t[1] + 1,
-            t[2] + 1,
-            t[3] + 1
-        )
-        .unwrap();
+    }
+    writeln!(s, "Tetrahedra\n{}", 6 * cubes).unwrap();
+    for cube in 0..cubes {
+        for (a, b) in [(1, 2), (1, 4), (2, 1), (2, 4), (4, 1), (4, 2)] {
+            let mut t = [0usize, a, a | b, 7];
+            let c = t.map(|b| layer_point(b & 3, cube + (b >> 2)));
+            let d = |i: usize| [0, 1, 2].map(|k| c[i][k] - c[0][k]);
+            let (u, v, w) = (d(1), d(2), d(3));
+            let det = u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0])
+                + u[2] * (v[0] * w[1] - v[1] * w[0]);
+            if det < 0.0 {
+                t.swap(1, 2);
+            }
+            let t = t.map(|b| (cube + (b >> 2)) * 4 + (b & 3) + 1);
+            writeln!(s, "{} {} {} {} {}", t[0], t[1], t[2], t[3], label(a)).unwrap();
+        }
     }
     s.push_str("End\n");
     s
+}
+
+/// The cube [0, 2]³ as its six Kuhn tets (around the diagonal from the origin), the three
+/// whose path leaves the origin along x in region 1 and the others in region 7, as Medit text.
+fn kuhn_cube() -> String {
+    kuhn_cubes(1, |a| if a == 1 { 1 } else { 7 })
 }
 
 fn cube_file(dir: &Path) -> std::path::PathBuf {
@@ -57,51 +64,13 @@ fn cube_file(dir: &Path) -> std::path::PathBuf {
     path
 }
 
-/// Two Kuhn cubes of side 2 stacked along z (points shared at z = 2), as Medit text.
-fn stacked_cubes() -> String {
-    let p = |b: usize, layer: usize| {
-        [
-            (b & 1) as f64 * 2.0,
-            (b >> 1 & 1) as f64 * 2.0,
-            layer as f64 * 2.0,
-        ]
-    };
-    let mut s = String::from("MeshVersionFormatted 2\nDimension 3\nVertices\n12\n");
-    for layer in 0..3 {
-        for b in 0..4 {
-            let q = p(b, layer);
-            writeln!(s, "{} {} {} 0", q[0], q[1], q[2]).unwrap();
-        }
-    }
-    s.push_str("Tetrahedra\n12\n");
-    for cube in 0..2 {
-        for (a, b) in [(1, 2), (1, 4), (2, 1), (2, 4), (4, 1), (4, 2)] {
-            // Corner b of the cube: layer cube + (b >> 2), index b & 3 in it.
-            let id = |b: usize| (cube + (b >> 2)) * 4 + (b & 3);
-            let mut t = [0usize, a, a | b, 7];
-            let c = t.map(|b| p(b & 3, cube + (b >> 2)));
-            let d = |i: usize| [0, 1, 2].map(|k| c[i][k] - c[0][k]);
-            let (u, v, w) = (d(1), d(2), d(3));
-            let det = u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0])
-                + u[2] * (v[0] * w[1] - v[1] * w[0]);
-            if det < 0.0 {
-                t.swap(1, 2);
-            }
-            let t = t.map(id);
-            writeln!(s, "{} {} {} {} 1", t[0] + 1, t[1] + 1, t[2] + 1, t[3] + 1).unwrap();
-        }
-    }
-    s.push_str("End\n");
-    s
-}
-
 /// A plane through faces shared by tets on both sides (z = 2 between the stacked cubes) shows
 /// those faces: the cut covers the whole 2 × 2 square, drawn once.
 #[test]
 fn a_cut_through_a_layer_of_faces_has_no_holes() {
     let dir = tempfile::tempdir().unwrap();
     let mesh = dir.path().join("stack.mesh");
-    std::fs::write(&mesh, stacked_cubes()).unwrap();
+    std::fs::write(&mesh, kuhn_cubes(2, |_| 1)).unwrap();
     assert!(biotet(&["check", s(&mesh), "--quiet"]).status.success());
     let out = dir.path().join("cut.svg");
     let r = json_of(&biotet(&[

@@ -438,14 +438,7 @@ fn enclose(points: &mut Vec<[f64; 3]>, regions: &mut Vec<u32>) {
     if points.is_empty() {
         return;
     }
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in points.iter() {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
+    let (lo, hi) = crate::geom::vec3::points_bbox(points.iter());
     let extent = (0..3)
         .map(|k| hi[k] - lo[k])
         .fold(0.0, f64::max)

@@ -78,14 +78,7 @@ pub struct Args {
 
 /// The middle of the points' bounding box.
 fn middle(mesh: &TetMesh) -> [f64; 3] {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in &mesh.points {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
+    let (lo, hi) = biotet::geom::vec3::points_bbox(&mesh.points);
     if lo[0] > hi[0] {
         return [0.0; 3];
     }

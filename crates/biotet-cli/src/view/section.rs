@@ -176,7 +176,7 @@ pub fn cut(
         // positive side (a plane through a grid of faces, x = 20 on a 1 mm image's mesh, would
         // otherwise leave holes).
         let on = s.iter().filter(|&&x| x == 0.0).count();
-        if !(neg && pos) && !(pos && on == 3) {
+        if !(pos && (neg || on == 3)) {
             continue;
         }
         let pts = cut_points(plane, &c, &s, &TET_EDGES);

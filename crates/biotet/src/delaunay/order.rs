@@ -104,15 +104,7 @@ fn cmp_coords(a: [f64; 3], b: [f64; 3]) -> std::cmp::Ordering {
 /// Sort `idx` (input indices) along the Hilbert curve of their bounding cube; returns the sorted
 /// keys `(hilbert << 32) | index`.
 fn hilbert_sort(points: &[[f64; 3]], idx: impl Iterator<Item = u32> + Clone) -> Vec<u64> {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for i in idx.clone() {
-        let p = points[i as usize];
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
+    let (lo, hi) = crate::geom::vec3::points_bbox(idx.clone().map(|i| &points[i as usize]));
     let ext = (0..3).map(|k| hi[k] - lo[k]).fold(0.0f64, f64::max);
     let cells = f64::from(1u32 << HILBERT_BITS);
     let scale = if ext > 0.0 { cells / ext } else { 0.0 };

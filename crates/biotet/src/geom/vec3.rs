@@ -54,17 +54,23 @@ pub fn volume6(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> f64 {
     dot(sub(b, a), cross(sub(c, a), sub(d, a)))
 }
 
-/// The axis-aligned box `(lo, hi)` of `N` points (a triangle's or a tet's corners): exact, as
-/// min and max are; callers cull with it before exact tests.
-#[inline]
-pub fn bbox<const N: usize>(c: &[[f64; 3]; N]) -> ([f64; 3], [f64; 3]) {
-    let mut lo = c[0];
-    let mut hi = c[0];
-    for p in &c[1..] {
+/// The axis-aligned box `(lo, hi)` of any number of points; `lo` above `hi` (infinite) when
+/// there are none.
+pub fn points_bbox<'a>(pts: impl IntoIterator<Item = &'a [f64; 3]>) -> ([f64; 3], [f64; 3]) {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in pts {
         for k in 0..3 {
             lo[k] = lo[k].min(p[k]);
             hi[k] = hi[k].max(p[k]);
         }
     }
     (lo, hi)
+}
+
+/// The axis-aligned box `(lo, hi)` of `N` points (a triangle's or a tet's corners): exact, as
+/// min and max are; callers cull with it before exact tests.
+#[inline]
+pub fn bbox<const N: usize>(c: &[[f64; 3]; N]) -> ([f64; 3], [f64; 3]) {
+    points_bbox(c)
 }

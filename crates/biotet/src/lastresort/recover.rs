@@ -1757,16 +1757,15 @@ impl<'a> Recovery<'a> {
             CROSSED_MAX_TETS
         };
         let crossed = self.with_work(|view, w| view.crossed_tets(w, v, limit));
-        let enclosing = crossed.clone();
-        if let Some(crossed) = crossed.filter(|_| !tried) {
+        if let Some(crossed) = crossed.as_ref().filter(|_| !tried) {
             self.crossed_tried += 1;
-            if self.carve_and_fill(v, &crossed, kernel).is_ok() {
+            if self.carve_and_fill(v, crossed, kernel).is_ok() {
                 self.crossed_ok += 1;
                 return true;
             }
             // Then those and their face neighbours: still far smaller than the corners' cavity,
             // and on brain_20k it recovers all but 2 of the triangles the crossed tets miss.
-            let mut ring = crossed;
+            let mut ring = crossed.clone();
             self.with_work(|view, w| view.grow(w, &mut ring));
             if self.carve_and_fill(v, &ring, kernel).is_ok() {
                 self.crossed_ok += 1;
@@ -1777,7 +1776,7 @@ impl<'a> Recovery<'a> {
         let mut tets = self.with_work(|view, w| {
             let st = w.next_stamp();
             let mut tets = Vec::new();
-            for &t in enclosing.iter().flatten() {
+            for &t in crossed.iter().flatten() {
                 w.tet_mark[t as usize] = low(st);
                 tets.push(t);
             }

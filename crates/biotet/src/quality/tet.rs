@@ -48,39 +48,28 @@ pub fn dihedral_at(c: &[[f64; 3]; 4], e: usize) -> f64 {
 /// trigonometry and without cancellation for small angles (as `|u + v|²` of the two faces' unit
 /// outward normals), for ranking many tets cheaply. 0 for a degenerate tet.
 pub fn min_dihedral_chord2(c: &[[f64; 3]; 4]) -> f64 {
+    edge_chords2(c).map_or(0.0, |e| e.into_iter().fold(f64::INFINITY, f64::min))
+}
+
+/// `|u + v|²` of the two faces' unit outward normals at each edge of [`TET_EDGES`]
+/// (`4·sin²(θ/2)` of its dihedral angle θ); `None` for a degenerate tet.
+fn edge_chords2(c: &[[f64; 3]; 4]) -> Option<[f64; 6]> {
     let n = face_normals(c);
     let mut u = [[0.0; 3]; 4];
     for (ui, ni) in u.iter_mut().zip(&n) {
         let l = norm(*ni);
         if l == 0.0 {
-            return 0.0;
+            return None;
         }
         *ui = scale(*ni, 1.0 / l);
     }
-    let mut worst = f64::INFINITY;
-    for [k, l] in TET_EDGES {
-        worst = worst.min(norm2(add(u[k], u[l])));
-    }
-    worst
+    Some(TET_EDGES.map(|[k, l]| norm2(add(u[k], u[l]))))
 }
 
 /// `4·sin²(θ/2)` of the largest interior dihedral angle θ (as [`min_dihedral_chord2`] for the
 /// smallest): a cheap screen for tets above an angle. 4 for a degenerate tet.
 pub fn max_dihedral_chord2(c: &[[f64; 3]; 4]) -> f64 {
-    let n = face_normals(c);
-    let mut u = [[0.0; 3]; 4];
-    for (ui, ni) in u.iter_mut().zip(&n) {
-        let l = norm(*ni);
-        if l == 0.0 {
-            return 4.0;
-        }
-        *ui = scale(*ni, 1.0 / l);
-    }
-    let mut worst: f64 = 0.0;
-    for [k, l] in TET_EDGES {
-        worst = worst.max(norm2(add(u[k], u[l])));
-    }
-    worst
+    edge_chords2(c).map_or(4.0, |e| e.into_iter().fold(0.0, f64::max))
 }
 
 /// The smallest interior dihedral angle in degrees, from [`min_dihedral_chord2`]: one `asin`

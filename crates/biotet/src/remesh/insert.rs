@@ -20,6 +20,7 @@ use super::cavity::{Inner, cavities, replace};
 use super::{P3, RemeshError, RemeshReport};
 use crate::geom::intersect::{SegTri, seg_tri, triangles_meet};
 use crate::geom::predicates::{Sign, orient3d};
+use crate::geom::vec3::bbox;
 use crate::geom::vec3::{add, cross, dot, scale, sub};
 use crate::mesh::inside::{Location, RegionLocator};
 use crate::mesh::surface::SurfaceMesh;
@@ -28,7 +29,7 @@ use crate::mesh::validate::{ValidateOptions, validate_surface};
 use crate::pipeline::PipelineOptions;
 use crate::sizing::{Sizing, SizingError};
 use crate::surface::bvh::Bvh;
-use crate::surface::grid::{Grid, tri_box};
+use crate::surface::grid::Grid;
 use std::time::Instant;
 
 /// Embed the closed surface `surface` into `mesh` (see the module docs): the tets meeting it,
@@ -131,14 +132,7 @@ struct SurfaceIndex<'a> {
 impl<'a> SurfaceIndex<'a> {
     fn new(s: &'a SurfaceMesh) -> SurfaceIndex<'a> {
         let nt = s.triangles.len();
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for p in &s.points {
-            for k in 0..3 {
-                lo[k] = lo[k].min(p[k]);
-                hi[k] = hi[k].max(p[k]);
-            }
-        }
+        let (lo, hi) = crate::geom::vec3::points_bbox(&s.points);
         let mut edges = 0.0;
         for t in 0..nt {
             let c = s.corners(t);
@@ -191,7 +185,7 @@ impl<'a> SurfaceIndex<'a> {
 
     /// The surface triangles meeting the closed triangle `f`, in increasing order.
     fn meeting(&self, s: &SurfaceMesh, f: &[P3; 3], out: &mut Vec<u32>) {
-        let (lo, hi) = tri_box(f);
+        let (lo, hi) = bbox(f);
         if !self.overlaps(lo, hi) {
             out.clear();
             return;
@@ -234,7 +228,7 @@ fn refuse_contacts(
             }
             let face = mesh.face(t, i);
             let f = face.map(|v| mesh.points[v as usize]);
-            let (lo, hi) = tri_box(&f);
+            let (lo, hi) = bbox(&f);
             if !index.overlaps(lo, hi) {
                 continue;
             }

@@ -3,6 +3,7 @@
 //! every cell its bounding box overlaps; the box cells are remembered so removal does not need
 //! the (possibly moved) coordinates.
 
+use crate::geom::vec3::bbox;
 use rustc_hash::FxHashMap;
 
 type P3 = [f64; 3];
@@ -14,19 +15,6 @@ pub struct Grid {
     h: f64,
     cells: FxHashMap<[i32; 3], Vec<u32>>,
     of: Vec<Option<Cells>>,
-}
-
-/// The bounding box of a triangle.
-pub fn tri_box(t: &[P3; 3]) -> (P3, P3) {
-    let mut lo = t[0];
-    let mut hi = t[0];
-    for p in &t[1..] {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    (lo, hi)
 }
 
 impl Grid {
@@ -47,7 +35,7 @@ impl Grid {
 
     /// List triangle `t` with corners `c`.
     pub fn insert(&mut self, t: u32, c: &[P3; 3]) {
-        let (lo, hi) = tri_box(c);
+        let (lo, hi) = bbox(c);
         let r = self.range(lo, hi);
         if self.of.len() <= t as usize {
             self.of.resize(t as usize + 1, None);

@@ -20,9 +20,10 @@ use rustc_hash::FxHashSet;
 
 use super::bvh::{PatchIndex, closest_on_triangle, dist2, unit_normal};
 use super::features::{Features, key};
-use super::grid::{Grid, tri_box};
+use super::grid::Grid;
 use super::guard::InputSamples;
 use crate::geom::intersect::{is_degenerate, tri_tri};
+use crate::geom::vec3::bbox;
 use crate::geom::vec3::{add, cross, dot, norm, scale, sub};
 use crate::mesh::surface::SurfaceMesh;
 
@@ -247,7 +248,7 @@ impl<'a> Remesher<'a> {
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
         for c in old_c {
-            let (a, b) = tri_box(c);
+            let (a, b) = bbox(c);
             for k in 0..3 {
                 lo[k] = lo[k].min(a[k] - tol);
                 hi[k] = hi[k].max(b[k] + tol);
@@ -305,7 +306,7 @@ impl<'a> Remesher<'a> {
                     return true;
                 }
             }
-            let (lo, hi) = tri_box(c);
+            let (lo, hi) = bbox(c);
             let mut cand = std::mem::take(&mut self.scratch);
             self.grid.query(lo, hi, &mut cand);
             let mut bad = false;
@@ -314,7 +315,7 @@ impl<'a> Remesher<'a> {
                     continue;
                 }
                 let d = self.corners(u);
-                let (dlo, dhi) = tri_box(&d);
+                let (dlo, dhi) = bbox(&d);
                 if (0..3).any(|k| dlo[k] > hi[k] || dhi[k] < lo[k]) {
                     continue;
                 }

@@ -60,7 +60,8 @@ const PIECE: usize = 128;
 /// result is the same on any number of threads.
 pub fn seal_triangles(t: &mut Template, surface: &SurfaceMesh, size: &[f64]) -> usize {
     let mut sealed = 0;
-    let points = point_grid(surface);
+    // Built on first use: most surfaces have no triangle that needs a cap.
+    let points = std::sync::OnceLock::new();
     let n_tri = surface.triangles.len();
     let ids: Vec<usize> = (0..n_tri).collect();
     for wave in ids.chunks(WAVE) {
@@ -91,7 +92,7 @@ pub fn seal_triangles(t: &mut Template, surface: &SurfaceMesh, size: &[f64]) -> 
 fn seal_one(
     t: &Template,
     surface: &SurfaceMesh,
-    points: &Grid,
+    points: &std::sync::OnceLock<Grid>,
     size: &[f64],
     s: usize,
     out: &mut Vec<usize>,
@@ -147,7 +148,15 @@ fn seal_one(
                 ball_voxels(t, c, r, out);
             } else if r <= CAP_MAX_SIZES * dmin
                 && let Some(inward) = inward_normal(surface.sides[s], n)
-                && let Some(h) = cap_height(surface, points, s, c, r, inward, dmin * HEIGHT_FACTOR)
+                && let Some(h) = cap_height(
+                    surface,
+                    points.get_or_init(|| point_grid(surface)),
+                    s,
+                    c,
+                    r,
+                    inward,
+                    dmin * HEIGHT_FACTOR,
+                )
             {
                 cap_voxels(t, c, r, h, inward, out);
             }

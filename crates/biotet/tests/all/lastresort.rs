@@ -380,14 +380,7 @@ struct Inside {
 
 impl Inside {
     fn new(s: &SurfaceMesh) -> Inside {
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for p in &s.points {
-            for k in 0..3 {
-                lo[k] = lo[k].min(p[k]);
-                hi[k] = hi[k].max(p[k]);
-            }
-        }
+        let (lo, hi) = biotet::geom::vec3::points_bbox(&s.points);
         let n = 64;
         let cell = (hi[0] - lo[0]).max(hi[1] - lo[1]) / n as f64 * 1.0001;
         let mut grid = vec![Vec::new(); n * n];
