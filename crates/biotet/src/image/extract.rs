@@ -16,18 +16,12 @@
 //!   sphere; a set of its triangles is a disk iff it and its complement are connected).
 //!   This also covers grid edges (a label on two diagonal voxels around an edge fails at both
 //!   ends). Images break it — two voxels of one label touching only along an edge or a corner.
-//!   [`make_manifold`] repairs them first by relabelling voxels, always to a label of higher
-//!   *rank* (rank = the label value, the outside 0 lowest): a label non-manifold at a corner
-//!   either is the highest label there and grows over the corner's other voxels until it is
-//!   manifold, or gives its voxels there to the highest label (one voxel when one is enough,
-//!   in both cases). Every change raises a voxel's
-//!   rank, so the repair ends after at most (labels − 1) changes per voxel; it is counted in
-//!   [`ExtractReport::relabelled`]. Regions of different labels may touch at an edge or a
-//!   corner: `validate` and `check` accept that, as long as the outside is not pinched
-//!   there too — `check` reads a tet mesh's boundary as one surface whose pieces meeting only at
-//!   a point or an edge are separate; so, at every corner, each set of non-zero voxels joined
-//!   through faces must leave the other voxels connected, else its highest label grows over
-//!   the corner's outside voxels (again a rise in rank).
+//!   [`make_manifold`] (module [`super::repair`]) repairs them first by relabelling voxels,
+//!   keeping every region's connected components where one voxel's change can. Regions of
+//!   different labels may touch at an edge or a corner: `validate` and `check` accept that, as
+//!   long as the outside is not pinched there too — `check` reads a tet mesh's boundary as one
+//!   surface whose pieces meeting only at a point or an edge are separate; the repair sees to
+//!   that as well.
 //! - **Embedded.** Faces of the grid meet only in grid edges and corners, which are edges and
 //!   points of the triangulation.
 //! - **Volume.** Each region's surface encloses exactly its voxels' volume (after the repair).
@@ -45,6 +39,7 @@
 use rustc_hash::FxHashMap;
 
 use super::LabelImage;
+pub use super::repair::make_manifold;
 use crate::SurfaceMesh;
 
 /// What [`extract`] did.
@@ -56,169 +51,6 @@ pub struct ExtractReport {
     pub n_points: usize,
     /// Triangles of the surface (two per voxel face).
     pub n_triangles: usize,
-}
-
-/// `true` for the masks of the 8 voxels around a grid corner (bit `dx + 2·dy + 4·dz`) whose set
-/// and complement are both connected through faces (or empty): the manifold configurations.
-fn manifold_table() -> [bool; 256] {
-    fn connected(m: u32) -> bool {
-        if m == 0 {
-            return true;
-        }
-        let start = m.trailing_zeros();
-        let mut seen = 1u32 << start;
-        let mut stack = vec![start];
-        while let Some(c) = stack.pop() {
-            for bit in [1, 2, 4] {
-                let n = c ^ bit;
-                if m & (1 << n) != 0 && seen & (1 << n) == 0 {
-                    seen |= 1 << n;
-                    stack.push(n);
-                }
-            }
-        }
-        seen == m
-    }
-    std::array::from_fn(|m| connected(m as u32) && connected(!(m as u32) & 0xff))
-}
-
-/// The labels of the 8 voxels around grid corner `(a, b, c)` (corner `(a, b, c)` lies between
-/// voxels `a − 1` and `a` along x, and so on); voxels outside the image are 0. Also returns
-/// their linear indices (`usize::MAX` outside).
-fn block(img: &LabelImage, a: usize, b: usize, c: usize) -> ([u32; 8], [usize; 8]) {
-    let mut l = [0u32; 8];
-    let mut idx = [usize::MAX; 8];
-    for n in 0..8 {
-        let (dx, dy, dz) = (n & 1, (n >> 1) & 1, (n >> 2) & 1);
-        let (i, j, k) = (a + dx, b + dy, c + dz);
-        if i == 0 || j == 0 || k == 0 || i > img.dims[0] || j > img.dims[1] || k > img.dims[2] {
-            continue;
-        }
-        let v = img.index(i - 1, j - 1, k - 1);
-        l[n] = img.labels[v];
-        idx[n] = v;
-    }
-    (l, idx)
-}
-
-/// The outside (label 0) must be manifold too, as `check` reads a tet mesh's boundary: at a
-/// corner, each connected set of non-zero voxels (regions joined through faces) must leave the
-/// rest connected. Returns the highest label of the first set that does not, and the set's
-/// mask; growing that label over the corner's outside voxels repairs it.
-fn outside_pinch(l: &[u32; 8], ok: &[bool; 256]) -> Option<(u32, usize)> {
-    let mut done = 0usize;
-    for s in 0..8 {
-        if l[s] == 0 || done & (1 << s) != 0 {
-            continue;
-        }
-        let mut m = 1usize << s;
-        let mut stack = vec![s];
-        while let Some(c) = stack.pop() {
-            for bit in [1, 2, 4] {
-                let n = c ^ bit;
-                if l[n] != 0 && m & (1 << n) == 0 {
-                    m |= 1 << n;
-                    stack.push(n);
-                }
-            }
-        }
-        done |= m;
-        if !ok[m] {
-            let top = (0..8).filter(|&n| m & (1 << n) != 0).map(|n| l[n]).max();
-            return top.map(|t| (t, m));
-        }
-    }
-    None
-}
-
-/// Relabel voxels until every non-zero label is manifold at every grid corner (see the
-/// [module documentation](self)). Returns `(from, to, voxels)` for the changes, sorted.
-pub fn make_manifold(img: &mut LabelImage) -> Vec<(u32, u32, usize)> {
-    let ok = manifold_table();
-    let [nx, ny, nz] = img.dims;
-    let (cx, cy) = (nx + 1, ny + 1);
-    let corners = cx * cy * (nz + 1);
-    let mut queued = vec![true; corners];
-    let mut queue: std::collections::VecDeque<usize> = (0..corners).collect();
-    let mut changes: FxHashMap<(u32, u32), usize> = FxHashMap::default();
-    while let Some(q) = queue.pop_front() {
-        queued[q] = false;
-        let (a, b, c) = (q % cx, (q / cx) % cy, q / (cx * cy));
-        let (l, idx) = block(img, a, b, c);
-        if l.iter().all(|&x| x == l[0]) {
-            continue;
-        }
-        let top = *l.iter().max().expect("8 labels");
-        // The first non-manifold non-zero label, if any.
-        let mut bad = None;
-        for &lab in &l {
-            if lab == 0 {
-                continue;
-            }
-            let m = (0..8).fold(0usize, |m, n| m | (((l[n] == lab) as usize) << n));
-            if !ok[m] {
-                bad = Some((lab, m));
-                break;
-            }
-        }
-        let Some((lab, m)) = bad.or_else(|| outside_pinch(&l, &ok)) else {
-            continue;
-        };
-        let mut set = |n: usize, to: u32, img: &mut LabelImage| {
-            let v = idx[n];
-            *changes.entry((img.labels[v], to)).or_default() += 1;
-            img.labels[v] = to;
-            // Re-examine the 8 corners of the changed voxel.
-            let (i, j, k) = (v % nx, (v / nx) % ny, v / (nx * ny));
-            for dz in 0..2 {
-                for dy in 0..2 {
-                    for dx in 0..2 {
-                        let w = (i + dx) + cx * ((j + dy) + cy * (k + dz));
-                        if !queued[w] {
-                            queued[w] = true;
-                            queue.push_back(w);
-                        }
-                    }
-                }
-            }
-        };
-        // A pinched outside grows the pinching set's top label over outside voxels only.
-        let pinch = bad.is_none();
-        let top = if pinch { lab } else { top };
-        if lab == top {
-            // Grow over lower labels: the first single in-image voxel whose change makes the
-            // set manifold, else all of the corner's in-image voxels it may take.
-            let may = |n: usize| m & (1 << n) == 0 && idx[n] != usize::MAX && (!pinch || l[n] == 0);
-            match (0..8).find(|&n| may(n) && ok[m | (1 << n)]) {
-                Some(n) => set(n, lab, img),
-                None => {
-                    for n in (0..8).filter(|&n| may(n)) {
-                        set(n, lab, img);
-                    }
-                }
-            }
-        } else {
-            // Give voxels to the highest label: the first single one that makes the label
-            // manifold here, else all of its voxels at the corner.
-            let mine = |n: usize| m & (1 << n) != 0;
-            match (0..8).find(|&n| mine(n) && ok[m & !(1 << n)]) {
-                Some(n) => set(n, top, img),
-                None => {
-                    for n in (0..8).filter(|&n| mine(n)) {
-                        set(n, top, img);
-                    }
-                }
-            }
-        }
-        // The corner itself may need more work.
-        if !queued[q] {
-            queued[q] = true;
-            queue.push_back(q);
-        }
-    }
-    let mut v: Vec<(u32, u32, usize)> = changes.into_iter().map(|((f, t), n)| (f, t, n)).collect();
-    v.sort_unstable();
-    v
 }
 
 /// The multi-label surface of an image (the image is first made manifold per label by
@@ -308,13 +140,6 @@ pub fn faces(img: &LabelImage) -> SurfaceMesh {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn table_counts() {
-        let t = manifold_table();
-        assert!(t[0] && t[255] && t[1] && t[3] && t[0x0f]);
-        assert!(!t[0b1001] && !t[0b1000_0001]); // diagonal along a face, through the block
-    }
 
     #[test]
     fn single_voxel_is_a_cube() {

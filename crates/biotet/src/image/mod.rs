@@ -10,11 +10,14 @@
 //!   components, small islands merged into their surroundings.
 //! - [`extract`]: the voxel-face surface of all label interfaces, one conforming labelled
 //!   [`crate::SurfaceMesh`], each region closed and manifold.
+//! - [`repair`]: voxels relabelled so that every label is manifold at every grid corner,
+//!   keeping each region's connected components.
 //! - [`surface`]: both, on an image, with the summary the reports print (shared by the CLI and
 //!   the Python package).
 
 pub mod extract;
 pub mod labels;
+pub mod repair;
 pub mod surface;
 
 /// Apply an affine map (the last row `[0, 0, 0, 1]`) to points in place.

@@ -3,7 +3,7 @@
 
 use biotet::image::LabelImage;
 use biotet::image::extract::{extract, make_manifold};
-use biotet::image::labels::{LabelOptions, apply};
+use biotet::image::labels::{Components, LabelOptions, apply};
 use biotet::mesh::validate::{ValidateOptions, validate_surface};
 use biotet::pipeline::{PipelineOptions, mesh_surface};
 use biotet::quality::tet::volume;
@@ -169,6 +169,45 @@ fn one_label_touching_itself_diagonally_is_repaired() {
         }
     });
     assert!(extract_and_mesh(img, 1.0).0 > 0);
+}
+
+/// Connected components per non-zero label, sorted by label.
+fn components(img: &LabelImage) -> Vec<(u32, usize)> {
+    let mut v: Vec<(u32, usize)> = Vec::new();
+    for c in Components::of(img).list.iter().filter(|c| c.label != 0) {
+        match v.iter_mut().find(|x| x.0 == c.label) {
+            Some(x) => x.1 += 1,
+            None => v.push((c.label, 1)),
+        }
+    }
+    v.sort_unstable();
+    v
+}
+
+#[test]
+fn a_repair_keeps_each_regions_components() {
+    // A ring of grey matter (1) closed by a diagonal step, in white matter (2) that also has an
+    // enclosed column. By rank alone the repair gave the step's grey voxel to white matter and
+    // joined the column to the rest (2 components to 1); a safe change gives an outer white
+    // voxel to grey matter instead, and every count stays.
+    const RING: [[u32; 5]; 5] = [
+        [2, 2, 2, 2, 2],
+        [2, 1, 1, 1, 2],
+        [2, 1, 2, 1, 2],
+        [2, 1, 1, 2, 2],
+        [2, 2, 2, 2, 2],
+    ];
+    let img = image([5, 5, 2], |i, j, _| RING[4 - j as usize][i as usize]);
+    let before = components(&img);
+    assert_eq!(before, vec![(1, 1), (2, 2)]);
+    let mut repaired = img.clone();
+    let changed = make_manifold(&mut repaired);
+    assert!(!changed.is_empty());
+    assert_eq!(components(&repaired), before);
+    assert_eq!(
+        extract_and_mesh(img, 1.0).0,
+        changed.iter().map(|c| c.2).sum()
+    );
 }
 
 #[test]
