@@ -32,6 +32,11 @@ pub struct Closest {
     pub triangle: u32,
 }
 
+/// The triangle that answered a caller's last [`Bvh::any_within_hinted`] query (one per caller
+/// and thread; start from `Hint::default()`).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Hint(Option<u32>);
+
 /// A bounding-volume hierarchy over triangles, for closest-point queries.
 #[derive(Debug, Clone)]
 pub struct Bvh {
@@ -225,8 +230,20 @@ impl Bvh {
 
     /// Whether some triangle is within `sqrt(r2)` of `p` (stops at the first one found).
     pub fn any_within(&self, p: P3, r2: f64) -> bool {
+        self.any_within_hinted(p, r2, &mut Hint::default())
+    }
+
+    /// [`Self::any_within`], trying first the triangle that answered the last query with the
+    /// same `hint` (samples of one triangle are answered by the same few input triangles, so
+    /// most queries cost one distance instead of a descent); the answer does not depend on it.
+    pub fn any_within_hinted(&self, p: P3, r2: f64, hint: &mut Hint) -> bool {
         if self.nodes.is_empty() {
             return false;
+        }
+        if let Some(k) = hint.0
+            && dist2(p, closest_on_triangle(p, &self.tris[k as usize])) <= r2
+        {
+            return true;
         }
         let mut stack: Vec<u32> = Vec::with_capacity(64);
         stack.push(0);
@@ -238,6 +255,7 @@ impl Bvh {
             if node.count > 0 {
                 for &k in &self.order[node.start as usize..(node.start + node.count) as usize] {
                     if dist2(p, closest_on_triangle(p, &self.tris[k as usize])) <= r2 {
+                        hint.0 = Some(k);
                         return true;
                     }
                 }

@@ -13,7 +13,7 @@
 
 use rayon::prelude::*;
 
-use super::bvh::{PatchIndex, dist2};
+use super::bvh::{Hint, PatchIndex, dist2};
 
 type P3 = [f64; 3];
 
@@ -99,6 +99,7 @@ pub fn one_sided(
             let mut max = floor;
             let mut far: Option<Far> = None;
             let mut count = 0;
+            let mut hint = Hint::default();
             let fine_n = ((longest / fine).ceil() as usize).max(1);
             'again: loop {
                 for i in 0..=n {
@@ -119,7 +120,7 @@ pub fn one_sided(
                             }
                         }
                         // Only a sample farther than the maximum so far matters.
-                        if bvh.any_within(p, max * max) {
+                        if bvh.any_within_hinted(p, max * max, &mut hint) {
                             prev = Some((p, max));
                             continue;
                         }

@@ -18,7 +18,7 @@
 
 use rustc_hash::FxHashSet;
 
-use super::bvh::{PatchIndex, closest_on_triangle, dist2, unit_normal};
+use super::bvh::{Hint, PatchIndex, closest_on_triangle, dist2, unit_normal};
 use super::features::{Features, key};
 use super::grid::Grid;
 use super::guard::InputSamples;
@@ -219,12 +219,13 @@ impl<'a> Remesher<'a> {
             .sqrt();
         let n = ((longest / self.spacing).ceil() as usize).clamp(2, 6);
         let t2 = self.tol * self.tol;
+        let mut hint = Hint::default();
         for i in 0..=n {
             for j in 0..=n - i {
                 let k = n - i - j;
                 let w = [i as f64, j as f64, k as f64].map(|x| x / n as f64);
                 let p = [0, 1, 2].map(|a| w[0] * c[0][a] + w[1] * c[1][a] + w[2] * c[2][a]);
-                if !bvh.any_within(p, t2) {
+                if !bvh.any_within_hinted(p, t2, &mut hint) {
                     return false;
                 }
             }
@@ -234,8 +235,10 @@ impl<'a> Remesher<'a> {
 
     /// Whether the input stays within the working tolerance when the triangles `old` (all with
     /// side labels `sides`, corners `old_c`) are replaced by `new`: every input sample of that
-    /// sheet near `old` is within it of a new triangle or of a triangle that stays (or no
-    /// farther than it was).
+    /// sheet within it of an old triangle is within it of a new triangle or of a triangle that
+    /// stays. Samples farther from every old triangle need no test: every sample is within the
+    /// tolerance of the current surface (it starts as the input, each operation keeps it so, and
+    /// the tolerance never shrinks), so those are covered by triangles that stay.
     fn input_kept(
         &mut self,
         old_c: &[[P3; 3]],
@@ -247,33 +250,43 @@ impl<'a> Remesher<'a> {
         let t2 = tol * tol;
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
-        for c in old_c {
-            let (a, b) = bbox(c);
+        let boxes: Vec<(P3, P3)> = old_c
+            .iter()
+            .map(|c| {
+                let (a, b) = bbox(c);
+                (a.map(|x| x - tol), b.map(|x| x + tol))
+            })
+            .collect();
+        for (a, b) in &boxes {
             for k in 0..3 {
-                lo[k] = lo[k].min(a[k] - tol);
-                hi[k] = hi[k].max(b[k] + tol);
+                lo[k] = lo[k].min(a[k]);
+                hi[k] = hi[k].max(b[k]);
             }
         }
         let mut near = std::mem::take(&mut self.scratch2);
         self.samples.in_box(lo, hi, &mut near);
         let mut ok = true;
+        // The new triangle that covered the last sample is tried first (neighbouring samples
+        // mostly share it).
+        let mut last = 0;
         for &s in &near {
             if self.samples.sides[s as usize] != sides {
                 continue;
             }
             let p = self.samples.pts[s as usize];
-            let d_new = new
-                .iter()
-                .map(|(_, c)| dist2(p, closest_on_triangle(p, c)))
-                .fold(f64::INFINITY, f64::min);
-            if d_new <= t2 {
+            let near_old = old_c.iter().zip(&boxes).any(|(c, (a, b))| {
+                (0..3).all(|k| p[k] >= a[k] && p[k] <= b[k])
+                    && dist2(p, closest_on_triangle(p, c)) <= t2
+            });
+            if !near_old {
                 continue;
             }
-            let d_old = old_c
-                .iter()
-                .map(|c| dist2(p, closest_on_triangle(p, c)))
-                .fold(f64::INFINITY, f64::min);
-            if d_old > t2 && d_new <= d_old {
+            let within = |k: usize| dist2(p, closest_on_triangle(p, &new[k].1)) <= t2;
+            if !new.is_empty() && within(last) {
+                continue;
+            }
+            if let Some(k) = (0..new.len()).find(|&k| k != last && within(k)) {
+                last = k;
                 continue;
             }
             // The triangles that stay.
