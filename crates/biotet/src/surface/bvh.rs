@@ -32,10 +32,28 @@ pub struct Closest {
     pub triangle: u32,
 }
 
-/// The triangle that answered a caller's last [`Bvh::any_within_hinted`] query (one per caller
-/// and thread; start from `Hint::default()`).
-#[derive(Debug, Clone, Copy, Default)]
-pub struct Hint(Option<u32>);
+/// The triangles that answered a caller's last few [`Bvh::any_within_hinted`] queries, latest
+/// first (one per caller and thread; start from `Hint::default()`).
+#[derive(Debug, Clone, Copy)]
+pub struct Hint([u32; HINTS]);
+
+/// How many recent answers a [`Hint`] keeps.
+const HINTS: usize = 4;
+
+impl Default for Hint {
+    fn default() -> Self {
+        Hint([u32::MAX; HINTS])
+    }
+}
+
+impl Hint {
+    /// Put `k` first.
+    fn note(&mut self, k: u32) {
+        let at = self.0.iter().position(|&x| x == k).unwrap_or(HINTS - 1);
+        self.0.copy_within(0..at, 1);
+        self.0[0] = k;
+    }
+}
 
 /// A bounding-volume hierarchy over triangles, for closest-point queries.
 #[derive(Debug, Clone)]
@@ -233,17 +251,23 @@ impl Bvh {
         self.any_within_hinted(p, r2, &mut Hint::default())
     }
 
-    /// [`Self::any_within`], trying first the triangle that answered the last query with the
+    /// [`Self::any_within`], trying first the triangles that answered the last queries with the
     /// same `hint` (samples of one triangle are answered by the same few input triangles, so
-    /// most queries cost one distance instead of a descent); the answer does not depend on it.
+    /// most queries cost a distance or two instead of a descent); the answer does not depend on
+    /// it.
     pub fn any_within_hinted(&self, p: P3, r2: f64, hint: &mut Hint) -> bool {
         if self.nodes.is_empty() {
             return false;
         }
-        if let Some(k) = hint.0
-            && dist2(p, closest_on_triangle(p, &self.tris[k as usize])) <= r2
-        {
-            return true;
+        for i in 0..HINTS {
+            let k = hint.0[i];
+            if k == u32::MAX {
+                break;
+            }
+            if dist2(p, closest_on_triangle(p, &self.tris[k as usize])) <= r2 {
+                hint.note(k);
+                return true;
+            }
         }
         let mut stack: Vec<u32> = Vec::with_capacity(64);
         stack.push(0);
@@ -255,7 +279,7 @@ impl Bvh {
             if node.count > 0 {
                 for &k in &self.order[node.start as usize..(node.start + node.count) as usize] {
                     if dist2(p, closest_on_triangle(p, &self.tris[k as usize])) <= r2 {
-                        hint.0 = Some(k);
+                        hint.note(k);
                         return true;
                     }
                 }
