@@ -5,11 +5,12 @@
 //! [`improve`] runs:
 //! 1. [`features::find`]: the edges that are kept as they are (sharp edges, interface rims,
 //!    triple lines, edges of touching shells) and the points that never move;
-//! 2. [`remesh::Remesher`]: rounds of split / collapse / flip / tangential relaxation with
+//! 2. [`remesh::Remesher`]: thin necks opened (tubes narrower than the tolerance, whose walls
+//!    would stay needles), then rounds of split / collapse / flip / tangential relaxation with
 //!    projection onto the input (Botsch and Kobbelt 2004) at a uniform target edge length, every
 //!    operation checked (link condition, exact non-degeneracy and no crossing of any other
 //!    triangle, distance of samples to the input, no worse smallest angle), then a clean-up of
-//!    the triangles still under the target angle;
+//!    the triangles still under the target angle, necks opened again;
 //! 3. repair: the two-sided distance measured ([`hausdorff::one_sided`] both ways); where it
 //!    exceeds the working tolerance, the offending output triangle's longest edge is split and
 //!    the new point projected onto the input, until it does not (or a bounded number of rounds);
@@ -298,9 +299,11 @@ pub fn improve(
     // The loop keeps its samples within 0.7 D; the final measure then has room.
     r.spacing = (0.25 * l).max(d);
     r.target_angle = opts.target_angle_deg;
+    r.open_necks();
     for _ in 0..opts.rounds {
         r.round();
     }
+    r.open_necks();
     // The clean-up may use a little more of the tolerance (the final measure has room).
     r.tol = 0.8 * d;
     for _ in 0..6 {

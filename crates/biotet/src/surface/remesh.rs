@@ -29,6 +29,8 @@ use crate::mesh::surface::SurfaceMesh;
 
 type P3 = [f64; 3];
 
+mod necks;
+
 /// Smallest and largest angle of a triangle, in degrees.
 pub fn angles_deg(t: &[P3; 3]) -> (f64, f64) {
     let mut lo = 180.0f64;

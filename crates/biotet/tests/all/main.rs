@@ -16,5 +16,6 @@ mod side_labels;
 mod sizing;
 mod sizing_grid;
 mod smooth;
+mod surface;
 mod template;
 mod validate;
