@@ -119,6 +119,37 @@ fn mesh_with_surface_tolerance_passes_check_against_the_improved_surface() {
     assert_eq!(j["pipeline"]["missing_triangles"].as_u64(), Some(0));
     let c = biotet(&["check", "--surface", s(&surf), s(&mesh)]);
     assert!(c.status.success(), "{}", stderr(&c));
+    // `quality --distance` measures the mesh's surface against the input independently of the
+    // stage: it moved (the poles' needles are gone), by no more than the tolerance; against the
+    // improved surface it is zero (to rounding in the closest-point arithmetic).
+    let q = json_of(&biotet(&[
+        "quality",
+        s(&mesh),
+        "--surface",
+        s(&input),
+        "--distance",
+        "--json",
+    ]));
+    let d = &q["surface_distance"];
+    let (io, oi) = (
+        d["in_to_out"].as_f64().unwrap(),
+        d["out_to_in"].as_f64().unwrap(),
+    );
+    assert!(io > 0.01 && io <= 0.3 && oi > 0.01 && oi <= 0.3, "{d}");
+    let same = json_of(&biotet(&[
+        "quality",
+        s(&mesh),
+        "--surface",
+        s(&surf),
+        "--distance",
+        "--json",
+    ]));
+    for side in ["in_to_out", "out_to_in"] {
+        assert!(
+            same["surface_distance"][side].as_f64().unwrap() < 1e-9,
+            "{same}"
+        );
+    }
     // Without the option, no surface section.
     let plain = json_of(&biotet(&["mesh", s(&input), "--json"]));
     assert!(plain.get("surface").is_none());

@@ -2,7 +2,7 @@
 
 use crate::{Common, plot, progress::Stage};
 use anyhow::Result;
-use biotet::quality::{QualityReport, TriQualityReport, forced};
+use biotet::quality::{QualityReport, TriQualityReport, distance, forced};
 use biotet_io::MeshKind;
 use serde_json::json;
 use std::path::PathBuf;
@@ -12,7 +12,8 @@ use std::process::ExitCode;
 const EXAMPLES: &str = "\
 Examples:
   biotet quality brain.vtu --surface brain.stl --svg brain_quality.svg
-  biotet quality brain.vtu --json > brain_quality.json";
+  biotet quality brain.vtu --json > brain_quality.json
+  biotet quality smooth.vtu --surface brain.stl --distance";
 
 /// Arguments of `biotet quality`.
 #[derive(clap::Args)]
@@ -29,6 +30,15 @@ pub struct Args {
     /// 10°, or an input edge where the surface folds under 10°). Tet meshes only.
     #[arg(long = "surface", short = 's', value_name = "SURFACE")]
     surfaces: Vec<PathBuf>,
+    /// With --surface: also measure the two-sided distance between the mesh's boundary and
+    /// interface faces and the surface (sampled; with a Lipschitz upper bound), as one sheet —
+    /// how far a mesher moved the surface.
+    #[arg(long, requires = "surfaces")]
+    distance: bool,
+    /// The sample step of --distance on each triangle [default: the surface's median edge
+    /// length / 16].
+    #[arg(long, value_name = "H", requires = "distance")]
+    distance_spacing: Option<f64>,
     #[command(flatten)]
     common: Common,
 }
@@ -66,6 +76,18 @@ pub fn run(a: Args) -> Result<ExitCode> {
         let surface = super::input::surfaces(&a.surfaces, a.common, &stage)?;
         stage.set("measuring");
         let report = QualityReport::of(&mesh);
+        let distance = match (&surface, a.distance) {
+            (Some(s), true) => {
+                stage.set("measuring the distance to the surface");
+                let h = match a.distance_spacing {
+                    Some(h) if h > 0.0 && h.is_finite() => h,
+                    Some(h) => anyhow::bail!("--distance-spacing must be positive, got {h}"),
+                    None => biotet::surface::median_edge_length(s) / 16.0,
+                };
+                Some(distance::surface_distance(&mesh, s, h))
+            }
+            _ => None,
+        };
         let placement = surface.map(|s| {
             let f = forced::classify(&mesh, &s, FORCED_DEG);
             (
@@ -79,7 +101,9 @@ pub fn run(a: Args) -> Result<ExitCode> {
         }
         match placement {
             None => print(&report, a.common)?,
-            Some((by_place, forcing)) => print_placement(&report, &by_place, &forcing, a.common)?,
+            Some((by_place, forcing)) => {
+                print_placement(&report, &by_place, &forcing, distance.as_ref(), a.common)?
+            }
         }
     }
     Ok(ExitCode::SUCCESS)
@@ -89,11 +113,13 @@ pub fn run(a: Args) -> Result<ExitCode> {
 const FORCED_DEG: f64 = 10.0;
 
 /// The report with the placement split and the forcing: the JSON object gains `placement`,
-/// `forcing`, `n_forced` and `n_unforced_dihedral_lt_10`.
+/// `forcing`, `n_forced` and `n_unforced_dihedral_lt_10` (and `surface_distance` with
+/// `--distance`).
 fn print_placement(
     report: &QualityReport,
     by_place: &forced::PlacementQuality,
     forcing: &forced::ForcingSummary,
+    dist: Option<&distance::SurfaceDistance>,
     common: Common,
 ) -> Result<()> {
     if common.json {
@@ -106,6 +132,9 @@ fn print_placement(
                 "n_unforced_dihedral_lt_10".into(),
                 json!(forcing.n_unforced_dihedral_lt_10),
             );
+            if let Some(d) = dist {
+                o.insert("surface_distance".into(), serde_json::to_value(d)?);
+            }
         }
         crate::emit(&serde_json::to_string_pretty(&v)?);
     } else if !common.quiet {
@@ -131,6 +160,13 @@ fn print_placement(
             forcing.n_unforced_dihedral_lt_10,
             forcing.cause_text()
         );
+        if let Some(d) = dist {
+            text += &format!(
+                "\ndistance to the surface: {:.4} surface → mesh, {:.4} mesh → surface (bound \
+                 {:.4}; {} faces, {} samples spaced {:.4})",
+                d.in_to_out, d.out_to_in, d.bound, d.n_mesh_faces, d.n_samples, d.spacing
+            );
+        }
         crate::emit(&text);
     }
     Ok(())

@@ -3,6 +3,7 @@
 //!
 //! Measures are floating point on purpose: they rank and report, they never decide topology.
 
+pub mod distance;
 pub mod forced;
 pub mod interfaces;
 pub mod report;
