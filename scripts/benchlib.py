@@ -187,14 +187,19 @@ def read_surface(path):
     return p, inv.reshape(-1)[t].astype(np.int32)
 
 
-def write_node_ele(base, points, tets):
-    """TetGen .node/.ele (0-based), coordinates with the shortest repr that reads back to the same double."""
+def write_node_ele(base, points, tets, labels=None):
+    """TetGen .node/.ele (0-based), coordinates with the shortest repr that reads back to the same double; `labels`
+    (one per tet) become the .ele's region attribute."""
     with open(base + ".node", "w") as f:
         f.write(f"{len(points)} 3 0 0\n")
         f.writelines(f"{i} {float(q[0])!r} {float(q[1])!r} {float(q[2])!r}\n" for i, q in enumerate(points))
     with open(base + ".ele", "w") as f:
-        f.write(f"{len(tets)} 4 0\n")
-        f.writelines(f"{i} {e[0]} {e[1]} {e[2]} {e[3]}\n" for i, e in enumerate(tets))
+        if labels is None:
+            f.write(f"{len(tets)} 4 0\n")
+            f.writelines(f"{i} {e[0]} {e[1]} {e[2]} {e[3]}\n" for i, e in enumerate(tets))
+        else:
+            f.write(f"{len(tets)} 4 1\n")
+            f.writelines(f"{i} {e[0]} {e[1]} {e[2]} {e[3]} {int(a)}\n" for i, (e, a) in enumerate(zip(tets, labels)))
 
 
 def read_node(path):
@@ -238,7 +243,16 @@ def mesh_tetgen(p, t, opts):
     """TetGen (pip `tetgen`) with `switches`."""
     import tetgen
     g = tetgen.TetGen(p, t)
-    res = g.tetrahedralize(switches=opts.get("switches", "pq1.2Y"))
+    return tetgen_result(g.tetrahedralize(switches=opts.get("switches", "pq1.2Y")))
+
+
+def tetgen_result(res):
+    """pip TetGen's (nodes, tets, attributes, ...) as (nodes, tets) or, with region attributes (`A`), (nodes, tets,
+    labels)."""
+    import numpy as np
+    attrib = res[2] if len(res) > 2 else None
+    if attrib is not None and len(attrib) == len(res[1]):
+        return res[0], res[1], np.asarray(attrib).reshape(len(res[1]), -1)[:, 0]
     return res[0], res[1]
 
 
@@ -280,11 +294,32 @@ def mesh_ftetwild(p, t, opts):
     kw = {"num_threads": int(opts.get("threads", 1)), "quiet": True}
     if opts.get("edge_length"):
         kw["edge_length_abs"] = float(opts["edge_length"])
+    if opts.get("envelope"):
+        # fTetWild's envelope is relative to the bounding-box diagonal.
+        import numpy as np
+        diag = float(np.linalg.norm(p.max(axis=0) - p.min(axis=0)))
+        kw["epsilon"] = float(opts["envelope"]) / diag
     return pytetwild.tetrahedralize(p, t, **kw)
 
 
+def mesh_acvd_tetgen(p, t, opts):
+    """The surface remeshed by pyacvd (Voronoi clustering into `points` points, after subdividing each triangle into
+    nine), then TetGen `pq1.2Y` on it: the route users take to a better surface without a distance bound."""
+    import numpy as np, pyvista as pv, pyacvd, tetgen
+    faces = np.hstack([np.full((len(t), 1), 3), t]).astype(np.int64).ravel()
+    c = pyacvd.Clustering(pv.PolyData(p, faces))
+    c.subdivide(3)
+    c.cluster(int(opts["points"]))
+    m = c.create_mesh()
+    q = np.asarray(m.points, dtype=float)
+    f = np.asarray(m.faces).reshape(-1, 4)[:, 1:]
+    g = tetgen.TetGen(q, f)
+    return tetgen_result(g.tetrahedralize(switches=opts.get("switches", "pq1.2Y")))
+
+
 # tool -> (meshing function, the Python module it needs)
-CHILDREN = {"tetgen": (mesh_tetgen, "tetgen"), "gmsh": (mesh_gmsh, "gmsh"), "ftetwild": (mesh_ftetwild, "pytetwild")}
+CHILDREN = {"tetgen": (mesh_tetgen, "tetgen"), "gmsh": (mesh_gmsh, "gmsh"), "ftetwild": (mesh_ftetwild, "pytetwild"),
+            "acvd_tetgen": (mesh_acvd_tetgen, "pyacvd")}
 
 
 def child_main(argv):
@@ -299,10 +334,10 @@ def child_main(argv):
     reset_peak_rss()
     before = rss_kb()
     start = time.perf_counter()
-    points, tets = func(p, t, opts)
+    points, tets, *labels = func(p, t, opts)
     seconds = time.perf_counter() - start
     peak = peak_rss_kb()
-    write_node_ele(base, points, tets)
+    write_node_ele(base, points, tets, labels[0] if labels else None)
     print(json.dumps({"seconds": seconds, "rss_before_kb": before, "peak_rss_kb": peak}))
 
 

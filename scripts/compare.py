@@ -6,6 +6,7 @@ Installs nothing. The anchors come from PyPI (each is skipped, and said so, when
     pip install tetgen gmsh pytetwild meshio trimesh   # meshio (and numpy) are needed by every Python anchor
     pip install pymmg                                  # MMG: ships the mmg3d_O3 binary
     pip install matplotlib                             # only for --svg
+    pip install pyacvd pyvista                         # only for --tolerance (pyacvd + TetGen)
     cargo build --release -p biotet-cli
     python3 scripts/compare.py [SURFACE ...] [--repeat 3] [--svg docs/compare.svg] [--csv compare.csv]
 
@@ -41,6 +42,10 @@ triangle as a face, touching the surface at points only, interior; tets forced p
 input triangle with an angle under 10 degrees or an input edge where the surface folds under 10 degrees) and
 `biotet check --surface S --json` (validity, input triangles missing from the mesh). Placement is by exact
 coordinates, so for fTetWild, which moves the surface, nearly every tet counts as interior.
+
+With `--tolerance D[,D...]` the run is the surface-tolerance comparison instead (scripts/compare_tolerance.py: biotet
+`--surface-tolerance D` beside MMG `-hausd D`, fTetWild with its envelope D, and pyacvd + TetGen), on brain_20k, wm_20k
+and the nested model by default; `--tools` then picks among biotet, mmg, ftetwild, acvd+tetgen.
 
 Outputs: the markdown tables on stdout (with the command, the machine and the ratios to TetGen `pq1.2Y` measured in
 the same run), a CSV (--csv), the same markdown block in a file (--markdown) or in place of the block between
@@ -399,10 +404,22 @@ def main():
                     help=f"replace the block between {BEGIN} and {END} in this file with the markdown block")
     ap.add_argument("--json", metavar="FILE", help="also write every row (histograms included) as JSON")
     ap.add_argument("--ftetwild-threads", type=int, default=1, help="fTetWild's threads (default 1, as the others)")
+    ap.add_argument("--tolerance", metavar="D[,D...]",
+                    help="the surface-tolerance comparison instead (scripts/compare_tolerance.py): biotet "
+                         "--surface-tolerance D beside MMG -hausd D, fTetWild with envelope D and pyacvd + TetGen")
     ap.add_argument("--list-tools", action="store_true",
                     help="print which tools can run here (JSON: tool -> null or why not) and exit")
     a = ap.parse_args()
 
+    if a.tolerance:
+        import compare_tolerance
+        exe = benchlib.find_biotet(a.biotet)
+        tols = [float(x) for x in a.tolerance.split(",") if x.strip()]
+        tools = list(compare_tolerance.TOOLS) if a.tools == ",".join(TOOLS) else \
+            [t.strip() for t in a.tools.split(",") if t.strip()]
+        command = " ".join(["python3", os.path.relpath(os.path.abspath(__file__), os.getcwd()), *sys.argv[1:]])
+        compare_tolerance.main(exe, a.surfaces, tols, tools, svg=a.svg, json_out=a.json, command=command)
+        return
     tools = [t.strip() for t in a.tools.split(",") if t.strip()]
     unknown = [t for t in tools if t not in TOOLS]
     if unknown:

@@ -97,3 +97,47 @@ fn compare_script_runs_every_installed_tool_on_a_small_sphere() {
         "{md}"
     );
 }
+
+#[test]
+fn compare_script_tolerance_mode_measures_the_distance() {
+    let probe = Command::new("python3")
+        .args(["-c", "import numpy, meshio"])
+        .output();
+    if !probe.is_ok_and(|o| o.status.success()) {
+        eprintln!(
+            "python3 with numpy and meshio not available: skipping the --tolerance smoke test"
+        );
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let sphere = biotet::mesh::surface::SurfaceMesh::icosphere(10.0, 2);
+    biotet_io::write_surface(&dir.path().join("sphere.off"), &sphere).unwrap();
+    let out = Command::new("python3")
+        .current_dir(dir.path())
+        .arg(root().join("scripts/compare.py"))
+        .args(["sphere.off", "--tolerance", "0.5", "--tools", "biotet"])
+        .args([
+            "--json",
+            "rows.json",
+            "--biotet",
+            env!("CARGO_BIN_EXE_biotet"),
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rows: Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("rows.json")).unwrap()).unwrap();
+    let b = &rows[0];
+    assert_eq!(b["tool"], "biotet", "{rows}");
+    assert_eq!(b["status"], "ok", "{rows}");
+    // Measured by `biotet quality --distance`, independently of the stage: within D both ways.
+    for key in ["h_in_out", "h_out_in"] {
+        let h = b[key].as_f64().unwrap();
+        assert!((0.0..=0.5).contains(&h), "{key} {h}: {rows}");
+    }
+    assert!(b["tets"].as_u64().unwrap() > 0);
+}
