@@ -7,15 +7,22 @@ use serde_json::Value;
 use std::process::Command;
 use support::*;
 
-#[test]
-fn compare_script_runs_every_installed_tool_on_a_small_sphere() {
+/// Whether `python3` can import numpy and meshio (the script's anchors need them); says so when
+/// it cannot.
+fn python_ready(test: &str) -> bool {
     let probe = Command::new("python3")
         .args(["-c", "import numpy, meshio"])
         .output();
-    if !probe.is_ok_and(|o| o.status.success()) {
-        eprintln!(
-            "python3 with numpy and meshio not available: skipping the compare.py smoke test"
-        );
+    let ok = probe.is_ok_and(|o| o.status.success());
+    if !ok {
+        eprintln!("python3 with numpy and meshio not available: skipping {test}");
+    }
+    ok
+}
+
+#[test]
+fn compare_script_runs_every_installed_tool_on_a_small_sphere() {
+    if !python_ready("the compare.py smoke test") {
         return;
     }
     let script = root().join("scripts/compare.py");
@@ -100,13 +107,7 @@ fn compare_script_runs_every_installed_tool_on_a_small_sphere() {
 
 #[test]
 fn compare_script_tolerance_mode_measures_the_distance() {
-    let probe = Command::new("python3")
-        .args(["-c", "import numpy, meshio"])
-        .output();
-    if !probe.is_ok_and(|o| o.status.success()) {
-        eprintln!(
-            "python3 with numpy and meshio not available: skipping the --tolerance smoke test"
-        );
+    if !python_ready("the --tolerance smoke test") {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
