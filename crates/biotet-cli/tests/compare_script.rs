@@ -20,6 +20,29 @@ fn python_ready(test: &str) -> bool {
     ok
 }
 
+/// `scripts/compare.py sphere.off ARGS --biotet <this build>` in a new directory holding an
+/// icosahedron subdivided twice onto the sphere of radius 10 (320 triangles); the directory,
+/// after the script succeeded.
+fn compare_on_sphere(args: &[&str]) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    let sphere = biotet::mesh::surface::SurfaceMesh::icosphere(10.0, 2);
+    biotet_io::write_surface(&dir.path().join("sphere.off"), &sphere).unwrap();
+    let out = Command::new("python3")
+        .current_dir(dir.path())
+        .arg(root().join("scripts/compare.py"))
+        .arg("sphere.off")
+        .args(args)
+        .args(["--biotet", env!("CARGO_BIN_EXE_biotet")])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    dir
+}
+
 #[test]
 fn compare_script_runs_every_installed_tool_on_a_small_sphere() {
     if !python_ready("the compare.py smoke test") {
@@ -46,27 +69,7 @@ fn compare_script_runs_every_installed_tool_on_a_small_sphere() {
         .collect();
     assert!(installed.iter().any(|t| t == "biotet"), "{list}");
 
-    let dir = tempfile::tempdir().unwrap();
-    // An icosahedron subdivided twice onto the sphere of radius 10 (320 triangles).
-    let sphere = biotet::mesh::surface::SurfaceMesh::icosphere(10.0, 2);
-    biotet_io::write_surface(&dir.path().join("sphere.off"), &sphere).unwrap();
-    let out = Command::new("python3")
-        .current_dir(dir.path())
-        .arg(&script)
-        .args(["sphere.off", "--repeat", "1", "--csv", "out.csv"])
-        .args([
-            "--markdown",
-            "out.md",
-            "--biotet",
-            env!("CARGO_BIN_EXE_biotet"),
-        ])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let dir = compare_on_sphere(&["--repeat", "1", "--csv", "out.csv", "--markdown", "out.md"]);
 
     // One CSV row per installed tool.
     let csv = std::fs::read_to_string(dir.path().join("out.csv")).unwrap();
@@ -110,26 +113,14 @@ fn compare_script_tolerance_mode_measures_the_distance() {
     if !python_ready("the --tolerance smoke test") {
         return;
     }
-    let dir = tempfile::tempdir().unwrap();
-    let sphere = biotet::mesh::surface::SurfaceMesh::icosphere(10.0, 2);
-    biotet_io::write_surface(&dir.path().join("sphere.off"), &sphere).unwrap();
-    let out = Command::new("python3")
-        .current_dir(dir.path())
-        .arg(root().join("scripts/compare.py"))
-        .args(["sphere.off", "--tolerance", "0.5", "--tools", "biotet"])
-        .args([
-            "--json",
-            "rows.json",
-            "--biotet",
-            env!("CARGO_BIN_EXE_biotet"),
-        ])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let dir = compare_on_sphere(&[
+        "--tolerance",
+        "0.5",
+        "--tools",
+        "biotet",
+        "--json",
+        "rows.json",
+    ]);
     let rows: Value =
         serde_json::from_slice(&std::fs::read(dir.path().join("rows.json")).unwrap()).unwrap();
     let b = &rows[0];
