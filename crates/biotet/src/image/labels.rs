@@ -172,7 +172,8 @@ pub(crate) fn face_neighbours(dims: [usize; 3], v: usize, mut f: impl FnMut(usiz
     }
 }
 
-fn on_border(dims: [usize; 3], v: usize) -> bool {
+/// Whether voxel `v` (linear index) lies on the image's border.
+pub(crate) fn on_border(dims: [usize; 3], v: usize) -> bool {
     let i = v % dims[0];
     let j = (v / dims[0]) % dims[1];
     let k = v / (dims[0] * dims[1]);

@@ -39,7 +39,7 @@ use std::collections::VecDeque;
 use rustc_hash::FxHashMap;
 
 use super::LabelImage;
-use super::labels::Components;
+use super::labels::{Components, face_neighbours, on_border};
 
 /// How many safe changes one voxel may take (bounds the repair: safe changes may lower a rank).
 pub const SAFE_CHANGES: u8 = 2;
@@ -103,34 +103,27 @@ fn mask_of(l: &[u32; 8], lab: u32) -> usize {
 /// the rest connected. Returns the highest label of the first set that does not, and the set's
 /// mask; growing that label over the corner's outside voxels repairs it.
 fn outside_pinch(l: &[u32; 8], ok: &[bool; 256]) -> Option<(u32, usize)> {
-    let mut done = 0usize;
-    for s in 0..8 {
-        if l[s] == 0 || done & (1 << s) != 0 {
-            continue;
-        }
-        let m = nonzero_set(l, s);
-        done |= m;
-        if !ok[m] {
-            let top = (0..8).filter(|&n| m & (1 << n) != 0).map(|n| l[n]).max();
-            return top.map(|t| (t, m));
-        }
-    }
-    None
+    let m = nonzero_sets(l).find(|&m| !ok[m])?;
+    let top = (0..8).filter(|&n| m & (1 << n) != 0).map(|n| l[n]).max();
+    top.map(|t| (t, m))
 }
 
 /// The number of connected sets of non-zero voxels of a corner that pinch the outside.
 fn pinches(l: &[u32; 8], ok: &[bool; 256]) -> usize {
+    nonzero_sets(l).filter(|&m| !ok[m]).count()
+}
+
+/// The masks of a corner's connected sets of non-zero voxels, in order of their first voxel.
+fn nonzero_sets(l: &[u32; 8]) -> impl Iterator<Item = usize> + '_ {
     let mut done = 0usize;
-    let mut count = 0;
-    for s in 0..8 {
+    (0..8).filter_map(move |s| {
         if l[s] == 0 || done & (1 << s) != 0 {
-            continue;
+            return None;
         }
         let m = nonzero_set(l, s);
         done |= m;
-        count += !ok[m] as usize;
-    }
-    count
+        Some(m)
+    })
 }
 
 /// The connected set of non-zero voxels of a corner that holds voxel `s`.
@@ -308,31 +301,20 @@ impl Repair<'_> {
     /// The one component key of voxel `v`'s face neighbours of label `to`, or `None` when it
     /// has none or they lie in more than one component.
     fn joins_one(&self, v: usize, to: u32) -> Option<u32> {
-        let [nx, ny, nz] = self.img.dims;
-        let (i, j, k) = (v % nx, (v / nx) % ny, v / (nx * ny));
         let mut key = None;
         let mut one = true;
         let mut see = |k: u32| match key {
             None => key = Some(k),
             Some(x) => one &= x == k,
         };
-        let steps: [(bool, isize); 6] = [
-            (i > 0, -1),
-            (i + 1 < nx, 1),
-            (j > 0, -(nx as isize)),
-            (j + 1 < ny, nx as isize),
-            (k > 0, -((nx * ny) as isize)),
-            (k + 1 < nz, (nx * ny) as isize),
-        ];
-        for (inside, d) in steps {
-            if inside {
-                let w = (v as isize + d) as usize;
-                if self.img.labels[w] == to {
-                    see(self.keys.of_voxel[w]);
-                }
-            } else if to == 0 {
-                see(PADDING);
+        face_neighbours(self.img.dims, v, |w| {
+            if self.img.labels[w] == to {
+                see(self.keys.of_voxel[w]);
             }
+        });
+        // The padding around the image is outside, one component.
+        if to == 0 && on_border(self.img.dims, v) {
+            see(PADDING);
         }
         key.filter(|_| one)
     }

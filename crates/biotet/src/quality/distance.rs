@@ -6,7 +6,8 @@
 use serde::Serialize;
 
 use crate::SurfaceMesh;
-use crate::mesh::tet::{NO_NEIGHBOR, TetMesh};
+use crate::mesh::tet::TetMesh;
+use crate::quality::interfaces::labelled_faces;
 use crate::surface::bvh::PatchIndex;
 use crate::surface::hausdorff::one_sided;
 
@@ -30,25 +31,14 @@ pub struct SurfaceDistance {
 
 /// The faces of `mesh` on its boundary or between two labels, each once.
 pub fn surface_faces(mesh: &TetMesh) -> Vec<[u32; 3]> {
-    let mut out = Vec::new();
-    for (t, nb) in mesh.neighbors.iter().enumerate() {
-        for (f, &n) in nb.iter().enumerate() {
-            let across = (n != NO_NEIGHBOR).then_some(n as usize);
-            let keep = match across {
-                None => true,
-                Some(u) => u > t && mesh.labels.get(u) != mesh.labels.get(t),
-            };
-            if keep {
-                out.push(mesh.face(t, f));
-            }
-        }
-    }
-    out
+    labelled_faces(mesh)
+        .map(|(t, f, _)| mesh.face(t, f))
+        .collect()
 }
 
 /// The two-sided distance between `mesh`'s boundary and interface faces and `surface`, with
 /// samples spaced `spacing` on each triangle (both as one sheet: every face is measured against
-/// every triangle of the other side). `mesh` needs its adjacency.
+/// every triangle of the other side). `mesh` needs its adjacency and labels.
 pub fn surface_distance(mesh: &TetMesh, surface: &SurfaceMesh, spacing: f64) -> SurfaceDistance {
     let faces = surface_faces(mesh);
     let one = |n: usize| vec![[0u32, 0u32]; n];
