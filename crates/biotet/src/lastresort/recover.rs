@@ -100,7 +100,11 @@ pub struct RecoverOptions {
     /// Options of each cell's search (quality threshold ηe, node budget).
     pub search: SearchOptions,
     /// How many times a failing cavity is grown by one ring of tets before the triangle is put
-    /// back in the queue.
+    /// back in the queue. Once by default: each ring costs more than all before it (the search
+    /// scans the whole front at every node), and the second ring mostly proved cavities without
+    /// a fill that one interior point then fixes at once (the trimesh annulus: 0.66 s → 0.22 s,
+    /// the same mesh; gmsh's t13: 1.73 s → 1.12 s, fewer tets under 10°). The wide rounds grow
+    /// further where no point helps.
     pub max_grow: u32,
     /// Cavities larger than this many tets are not searched.
     pub max_cavity_tets: usize,
@@ -140,7 +144,7 @@ impl Default for RecoverOptions {
                 max_nodes: 400,
                 ..SearchOptions::default()
             },
-            max_grow: 2,
+            max_grow: 1,
             max_cavity_tets: 300,
             allow_interior_steiner: true,
             max_tries: 1,
