@@ -304,6 +304,27 @@ def cad_coarse_plate():
         return m.surface_mesh(size_max=1e3, extend=0, circle_points=16)
 
 
+def cad_two_balls_default():
+    """Two fused balls (radii 1 and 0.8, centres 1.2 apart) at gmsh's default sizes: OpenCASCADE writes the zeros of
+    the intersection circle as -1.5e-32, noise far below any exactness concern that once made biotet refuse the file."""
+    with Gmsh("two_balls_default") as m:
+        occ = m.g.model.occ
+        occ.fuse([(3, occ.addSphere(0, 0, 0, 1))], [(3, occ.addSphere(1.2, 0, 0, 0.8))])
+        return m.surface_mesh()
+
+
+def cad_chamfer_box():
+    """A 2-cube with four edges chamfered (0.3): planar chamfer faces; OpenCASCADE writes one zero as -7.7e-34."""
+    with Gmsh("chamfer_box") as m:
+        occ = m.g.model.occ
+        box = occ.addBox(0, 0, 0, 2, 2, 2)
+        occ.synchronize()
+        faces = [abs(s) for _, s in m.g.model.getBoundary([(3, box)])]
+        edges = sorted({abs(e) for _, e in m.g.model.getBoundary([(2, f) for f in faces], combined=False)})
+        occ.chamfer([box], edges[:4], [faces[0]] * 4, [0.3] * 4)
+        return m.surface_mesh(size_max=0.25)
+
+
 GMSH_SHARE = None
 
 
@@ -623,6 +644,9 @@ SHAPES = {
     "cad_l_bracket": (cad_l_bracket, GMSH_SRC, "generated", "L-bracket with 4 holes: many planar facets, concave edge"),
     "cad_coarse_block": (cad_coarse_block, GMSH_SRC, "generated", "coarse facets: long thin triangles on large planes"),
     "cad_coarse_plate": (cad_coarse_plate, GMSH_SRC, "generated", "coarse thin plate: slivers 100 long, 1 wide"),
+    "cad_two_balls_default": (cad_two_balls_default, GMSH_SRC, "generated",
+                              "boolean union of two balls, coarse; zeros written as -1.5e-32"),
+    "cad_chamfer_box": (cad_chamfer_box, GMSH_SRC, "generated", "chamfered edges; a zero written as -7.7e-34"),
     "cad_component8": (cad_component8, "gmsh {gmsh} OCC, STEP component8.step from the gmsh wheel",
                        LICENCE["gmsh"], "~13k-triangle machined part: facets, holes, sharp edges"),
     "cad_component8_f32": (cad_component8_f32, "gmsh {gmsh} OCC, component8.step, coordinates rounded to float32",
@@ -660,6 +684,9 @@ SHAPES = {
                    "thick ring: flat annular faces, two cylinders"),
     "tm_torus": (tm("torus", major_radius=2.0, minor_radius=0.5, major_sections=48, minor_sections=16),
                  "trimesh {trimesh} creation.torus(2, 0.5, 48, 16)", "generated", "genus 1, smooth"),
+    "tm_thin_torus": (tm("torus", major_radius=1.0, minor_radius=0.05, major_sections=64, minor_sections=12),
+                      "trimesh {trimesh} creation.torus(1, 0.05, 64, 12)", "generated",
+                      "thin tube (diameter a tenth of its ring): no room for template nodes"),
     "tm_icosphere": (tm("icosphere", subdivisions=3), "trimesh {trimesh} creation.icosphere(subdivisions=3)",
                      "generated", "smooth, well shaped (the easy case)"),
     "pkg_gmsh_t13": (pkg("gmsh", "tutorials/t13_data.stl"), "gmsh {gmsh} wheel: share/doc/gmsh/tutorials/t13_data.stl",

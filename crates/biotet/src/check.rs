@@ -44,7 +44,7 @@ pub struct CheckReport {
     /// Points with exactly the same coordinates as an earlier point.
     pub n_duplicate_points: usize,
     /// Non-finite coordinates, or coordinates outside the exact range of the predicates (0 or a
-    /// magnitude between 2⁻¹⁰⁰ and 1e50), where no sign could be trusted.
+    /// magnitude between 2⁻¹⁵⁰ and 1e50), where no sign could be trusted.
     pub n_nonfinite_points: usize,
     /// Label array length differs from the tet count (0 or 1).
     pub n_label_errors: usize,

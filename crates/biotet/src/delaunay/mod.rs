@@ -115,7 +115,7 @@ pub enum DelaunayError {
     /// than [`MIN_COORDINATE`]: exact arithmetic could overflow or underflow there.
     #[error(
         "point {index} has a coordinate outside the exact range (0, or magnitude between \
-         7.9e-31 and 1e50, where exact arithmetic neither underflows nor overflows): rescale the input"
+         7.0e-46 and 1e50, where exact arithmetic neither underflows nor overflows): rescale the input"
     )]
     OutOfRange {
         /// Index of the offending point in the input.

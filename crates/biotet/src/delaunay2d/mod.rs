@@ -49,7 +49,7 @@ pub enum Delaunay2dError {
     },
     /// A coordinate is outside the exact range of the predicates.
     #[error(
-        "point {index} has a coordinate outside the exact range (0, or magnitude between 7.9e-31 \
+        "point {index} has a coordinate outside the exact range (0, or magnitude between 7.0e-46 \
          and 1e50): rescale the input"
     )]
     OutOfRange {

@@ -21,11 +21,13 @@ use robust::{Coord, Coord3D};
 /// in-sphere cannot overflow.
 pub const MAX_COORDINATE: f64 = 1e50;
 
-/// Smallest non-zero coordinate magnitude for which the predicates stay exact, 2⁻¹⁰⁰ (about
-/// 7.9e-31): every coordinate difference is then a multiple of 2⁻¹⁵², so the degree-5 products of
-/// the exact stages are multiples of 2⁻⁷⁶⁰ and never underflow (the adaptive predicates are exact
-/// only without underflow).
-pub const MIN_COORDINATE: f64 = 7.888_609_052_210_118e-31;
+/// Smallest non-zero coordinate magnitude for which the predicates stay exact, 2⁻¹⁵⁰ (about
+/// 7.0e-46): every coordinate (and coordinate difference) is then a multiple of 2⁻²⁰², so the
+/// degree-5 products of the exact stages are multiples of 2⁻¹⁰¹⁰, never below the smallest normal
+/// double 2⁻¹⁰²² (the adaptive predicates are exact only without underflow). CAD kernels write
+/// zeros as noise of 1e-32 or so (OpenCASCADE through gmsh: -7.7e-34); such files are meshed as
+/// they are, not refused.
+pub const MIN_COORDINATE: f64 = 7.006_492_321_624_085e-46;
 
 /// True when `c` is 0 or its magnitude lies in [[`MIN_COORDINATE`], [`MAX_COORDINATE`]]: the range
 /// in which every predicate of this module is exact.

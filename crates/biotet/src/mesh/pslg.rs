@@ -41,7 +41,7 @@ pub enum PslgError {
     NoSegments,
     /// A coordinate is NaN, infinite or outside the exact range of the predicates.
     #[error(
-        "point {0} has a non-finite coordinate or one outside the exact range (0, or magnitude between 7.9e-31 and 1e50)"
+        "point {0} has a non-finite coordinate or one outside the exact range (0, or magnitude between 7.0e-46 and 1e50)"
     )]
     BadCoordinate(usize),
     /// Two points coincide.

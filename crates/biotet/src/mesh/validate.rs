@@ -482,7 +482,7 @@ pub enum SurfaceError {
     /// predicates, [`crate::geom::predicates::in_exact_range`]).
     #[error(
         "non-finite or out-of-range coordinates (exact predicates need 0 or a magnitude between \
-         7.9e-31 and 1e50): {}; first: {}",
+         7.0e-46 and 1e50): {}; first: {}",
         plural(*.count, "point"),
         point_list(.first)
     )]

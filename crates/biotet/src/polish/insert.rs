@@ -90,10 +90,54 @@ impl Work {
         }
         ring.sort_unstable();
         ring.dedup();
-        if ring == faces || ring == edges {
+        if ring != faces
+            && ring != edges
+            && let Some(ids) = self.insert_into(t, ring.clone(), thr, searcher, rp, sp, star)
+        {
+            return Some(ids);
+        }
+        // The tets whose circumspheres hold t's circumcentre (Delaunay refinement's cavity): in a
+        // domain thinner than the template's sealing zones (a thin tube) no interior node was
+        // placed, t spans it from wall to wall, and only a point on its axis with every tet of
+        // that cross-section refilled around it helps.
+        let ball = self.circumsphere_cavity(t, rp.max_tets)?;
+        if ball == faces || ball == edges || ball == ring {
             return None;
         }
-        self.insert_into(t, ring, thr, searcher, rp, sp, star)
+        self.insert_into(t, ball, thr, searcher, rp, sp, star)
+    }
+
+    /// The unforced tets of `t`'s label whose circumsphere strictly holds `t`'s circumcentre,
+    /// reached from `t` through faces (so never across a boundary or interface face), sorted; at
+    /// most `max` (else `None`). Floating point: it only chooses the cavity, whose use is decided
+    /// exactly by [`Self::insert_into`].
+    fn circumsphere_cavity(&mut self, t: u32, max: usize) -> Option<Vec<u32>> {
+        let x = circumcentre(&self.corners(t))?;
+        let label = self.labels[t as usize];
+        let mut out = vec![t];
+        let mut seen: FxHashSet<u32> = FxHashSet::default();
+        seen.insert(t);
+        let mut i = 0;
+        while i < out.len() {
+            let s = out[i];
+            i += 1;
+            for n in self.nb[s as usize] {
+                if n == NO_NEIGHBOR || !seen.insert(n) || self.labels[n as usize] != label {
+                    continue;
+                }
+                let c = self.corners(n);
+                let inside =
+                    circumcentre(&c).is_some_and(|o| norm2(sub(x, o)) < norm2(sub(c[0], o)));
+                if inside && !self.is_forced(n) {
+                    out.push(n);
+                    if out.len() > max {
+                        return None;
+                    }
+                }
+            }
+        }
+        out.sort_unstable();
+        Some(out)
     }
 
     /// A wedge: `t`'s one small angle, at edge `cd`, comes from the short opposite edge `ab`

@@ -5,7 +5,7 @@
 //! consistency of the Simulation-of-Simplicity versions.
 
 use biotet::geom::predicates::{
-    Sign, incircle, incircle_sos, insphere, insphere_sos, orient2d, orient3d,
+    Sign, in_exact_range, incircle, incircle_sos, insphere, insphere_sos, orient2d, orient3d,
 };
 use proptest::prelude::*;
 use proptest::strategy::ValueTree;
@@ -395,6 +395,41 @@ fn naive_orient3d_fails_on_exactly_coplanar_points() {
     }
     println!("naive orient3d non-zero on {naive_nonzero} of 500 coplanar quadruples");
     assert!(naive_nonzero > 0);
+}
+
+/// At the bottom of the exact range (coordinates down to 2⁻¹⁵⁰, as a CAD kernel's -7.7e-34 for a
+/// zero): lattice points scaled by 2⁻¹⁴⁶, where every value is exact, keep the lattice's exact
+/// signs for `orient3d` and `insphere`, zero included.
+#[test]
+fn the_smallest_coordinates_keep_exact_signs() {
+    assert!(in_exact_range(2f64.powi(-150)) && !in_exact_range(2f64.powi(-151)));
+    assert!(in_exact_range(-7.703719777548943e-34));
+    let s = 2f64.powi(-146);
+    let mut rng = Lcg(11);
+    let mut signs = [0usize; 3];
+    for r2 in RADII2 {
+        let pts = sphere_points(r2);
+        for _ in 0..300 {
+            let i = rng.distinct::<5>(pts.len());
+            let mut q = i.map(|k| pts[k]);
+            // Off the sphere for half the tuples, so every sign occurs.
+            if rng.next(2) == 0 {
+                q[4] = q[4].map(|x| x + 1);
+            }
+            let p = q.map(|x| place3(x, s, [0.0; 3]));
+            assert!(p.iter().flatten().all(|&c| in_exact_range(c)));
+            let o = orient3d(p[0], p[1], p[2], p[3]);
+            assert_eq!(o, exact_orient3d(q[0], q[1], q[2], q[3]), "orient3d {q:?}");
+            let e = insphere(p[0], p[1], p[2], p[3], p[4]);
+            assert_eq!(
+                e,
+                exact_insphere(q[0], q[1], q[2], q[3], q[4]),
+                "insphere {q:?}"
+            );
+            signs[(e.as_i32() + 1) as usize] += 1;
+        }
+    }
+    assert!(signs.iter().all(|&n| n > 0), "{signs:?}");
 }
 
 /// Integer points on spheres, translated by large exact offsets: `insphere` is exactly zero,
