@@ -19,6 +19,8 @@ use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
 use crate::geom::vec3::{norm, sub};
+
+mod thickness;
 use crate::mesh::surface::SurfaceMesh;
 
 /// Where the base size comes from.
@@ -280,7 +282,8 @@ impl Sizing {
     }
 }
 
-/// Mean length of the edges at each referenced surface node: `(positions, sizes)`.
+/// Mean length of the edges at each referenced surface node, capped at half the local thickness
+/// ([`thickness`]): `(positions, sizes)`.
 fn node_sizes(surface: &SurfaceMesh) -> Result<(Vec<[f64; 3]>, Vec<f64>), SizingError> {
     let n = surface.points.len();
     let mut sum = vec![0.0f64; n];
@@ -299,15 +302,18 @@ fn node_sizes(surface: &SurfaceMesh) -> Result<(Vec<[f64; 3]>, Vec<f64>), Sizing
     }
     let mut pos = Vec::new();
     let mut h = Vec::new();
+    let mut ids = Vec::new();
     for v in 0..n {
         if count[v] > 0 && sum[v] > 0.0 {
             pos.push(surface.points[v]);
             h.push(sum[v] / count[v] as f64);
+            ids.push(v as u32);
         }
     }
     if h.is_empty() {
         return Err(SizingError::EmptySurface);
     }
+    thickness::cap_by_thickness(surface, &ids, &mut h);
     Ok((pos, h))
 }
 
