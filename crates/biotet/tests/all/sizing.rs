@@ -9,7 +9,9 @@ fn surface_field_is_the_graded_cone_minimum() {
     let mut o = SizingOptions::new(SizeSpec::FromSurface { grading: 0.5 });
     o.min_size = Some(1.0);
     let z = Sizing::new(&s, o).unwrap();
-    let h = 200f64.sqrt(); // every edge of the octahedron
+    // Every edge is √200 ≈ 14.1, but each node faces the opposite one 20 away (less than twice
+    // that): the size is capped at half the thickness, 10 (see `sizing::thickness`).
+    let h = 10.0;
     assert!((z.at([10.0, 0.0, 0.0], 1) - h).abs() < 1e-12);
     // At the centre every node is 10 away: h + 0.5 * 10.
     assert!((z.at([0.0, 0.0, 0.0], 1) - (h + 5.0)).abs() < 1e-12);
