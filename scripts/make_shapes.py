@@ -465,6 +465,16 @@ CUBE_T = [[0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 5, 4],
           [1, 2, 6], [1, 6, 5], [2, 3, 7], [2, 7, 6], [3, 0, 4], [3, 4, 7]]
 
 
+def tm_box_random():
+    """trimesh's box with random extents turned by a random rotation (numpy seed 1): its faces' corners are coplanar
+    only to round-off, each face folded along its diagonal by about 1e-16."""
+    import trimesh
+    r = np.random.default_rng(1)
+    b = trimesh.creation.box(extents=r.uniform(0.2, 3.0, 3))
+    b.apply_transform(trimesh.transformations.random_rotation_matrix(r.random(3)))
+    return b.vertices, b.faces
+
+
 def gen_tetrahedron():
     return np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float), np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
 
@@ -687,6 +697,8 @@ SHAPES = {
     "tm_thin_torus": (tm("torus", major_radius=1.0, minor_radius=0.05, major_sections=64, minor_sections=12),
                       "trimesh {trimesh} creation.torus(1, 0.05, 64, 12)", "generated",
                       "thin tube (diameter a tenth of its ring): no room for template nodes"),
+    "tm_box_random": (tm_box_random, "trimesh {trimesh} creation.box, random extents and rotation (seed 1)", "generated",
+                      "box faces folded by round-off along their diagonals"),
     "tm_icosphere": (tm("icosphere", subdivisions=3), "trimesh {trimesh} creation.icosphere(subdivisions=3)",
                      "generated", "smooth, well shaped (the easy case)"),
     "pkg_gmsh_t13": (pkg("gmsh", "tutorials/t13_data.stl"), "gmsh {gmsh} wheel: share/doc/gmsh/tutorials/t13_data.stl",

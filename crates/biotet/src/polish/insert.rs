@@ -312,14 +312,16 @@ impl Work {
         let mut filled = cone_ok;
         if new.2 > 0 {
             // The search, with the point as the one inner point: first every tet above the
-            // threshold, then every tet above the cavity's worst before (any other fill would be
-            // rejected).
+            // threshold, then every tet above the cavity's worst before and the cone's (any other
+            // fill would be rejected, or replace a better cone: a box whose only fill of its
+            // corners has a flat tet got a cone at 9.8° and then a search fill through the same
+            // flat tet, and kept neither).
             let mut cands: Vec<u32> = on_shell.iter().copied().chain([p]).collect();
             cands.sort_unstable();
             // A tet covers at most four shell faces, so a fill has at least a quarter of the faces
             // with no tet above the threshold below it: more than before, and no fill can pass.
             let poor = faces_without_candidate(&self.pts, &cav.shell, &cands, thr);
-            for floor in [thr, old.1.max(0.0) * (1.0 + 1e-9)] {
+            for floor in [thr, old.1.max(new.1).max(0.0) * (1.0 + 1e-9)] {
                 if floor < thr && (large || poor.div_ceil(4) > old.2) {
                     break;
                 }
