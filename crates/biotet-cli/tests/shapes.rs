@@ -94,3 +94,26 @@ fn invalid_shapes_are_refused_naming_the_element_and_write_nothing() {
         assert!(!out.exists(), "{}: mesh wrote its output", s.display());
     }
 }
+
+/// Meshes whose worst tet a finite-element user would refuse: a box turned by a random rotation
+/// (its faces folded by round-off along their diagonals) kept a flat tet (0.00° / 180.0°) across
+/// a fold, where one interior point gives tets of 9.8° and more; a thin torus spanned its tube
+/// wall to wall (2e-15°) until the sizes were capped by the local thickness.
+#[test]
+fn no_flat_tet_on_a_turned_box_or_a_thin_torus() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/shapes");
+    for (name, floor) in [("tm_box_random", 5.0), ("tm_thin_torus", 10.0)] {
+        let s = root.join(format!("{name}.off"));
+        let out = dir.path().join(format!("{name}.vtu"));
+        let (s, out) = (s.to_str().unwrap(), out.to_str().unwrap());
+        let m = biotet(&["mesh", s, "-o", out, "-q"]);
+        assert!(m.status.success(), "{name}");
+        let q = biotet(&["quality", out, "--json"]);
+        let j: serde_json::Value = serde_json::from_slice(&q.stdout).unwrap();
+        let worst = j["min_dihedral_deg"].as_f64().unwrap();
+        assert!(worst >= floor, "{name}: smallest dihedral angle {worst}°");
+        let c = biotet(&["check", out, "--surface", s]);
+        assert!(c.status.success(), "{name}: check fails");
+    }
+}

@@ -339,7 +339,12 @@ impl Work {
                 }
             }
         }
-        if new.0 > old.0 && new.1 >= old.1 && new.2 <= old.2 {
+        // In the last pass, a nearly flat worst tet (under a tenth of the threshold) may go for a
+        // few just below the threshold: every new tet at least half of it (a box folded by
+        // round-off kept a 0.00° tet whose cone from one point is at 9.8°). Only last: earlier,
+        // such a trade can block a later fix that leaves none below the threshold.
+        let rescued = self.rescue_flat && old.1 < 0.1 * thr && new.1 >= 0.5 * thr;
+        if new.0 > old.0 && new.1 >= old.1 && (new.2 <= old.2 || rescued) {
             return Some(ids);
         }
         if filled {

@@ -124,6 +124,9 @@ pub struct PolishReport {
     pub inserts_accepted: usize,
     /// Of those, points in front of a wedge's short edge.
     pub wedges_accepted: usize,
+    /// Nearly flat unforced tets (under a tenth of the threshold) replaced in the last pass by a
+    /// point's tets, all at least half the threshold (possibly more of them below it).
+    pub flat_rescued: usize,
     /// Points added (inserted and still there at the end).
     pub points_added: usize,
     /// Unforced tets below the threshold before, by interior corners (see
@@ -262,6 +265,45 @@ pub fn polish(mesh: &mut TetMesh, opts: &PolishOptions) -> PolishReport {
                 opts.wedge.then_some(opts.wedge_lower_floor),
             ) {
                 break;
+            }
+        }
+        // Last, the nearly flat tets still there: a point whose tets are all at least half the
+        // threshold replaces one even with more of them below the threshold.
+        let flat: Vec<u32> = bad
+            .iter()
+            .filter(|x| x.0 < 0.1 * thr)
+            .map(|x| x.1)
+            .collect();
+        if !flat.is_empty() {
+            w.rescue_flat = true;
+            for t in flat {
+                if w.alive[t as usize]
+                    && w.min_angle(t) < 0.1 * thr
+                    && w.insert(t, thr, &mut searcher, &rp, &params, &mut star)
+                        .is_some()
+                {
+                    report.inserts_accepted += 1;
+                    report.flat_rescued += 1;
+                }
+            }
+            w.rescue_flat = false;
+            if report.flat_rescued > 0 {
+                bad = scan_all(&mut w, thr);
+                for &(_, t) in bad.clone().iter() {
+                    if w.alive[t as usize] && w.min_angle(t) < thr {
+                        let mut touched = Vec::new();
+                        move_corners(
+                            &mut w,
+                            t,
+                            thr,
+                            &params,
+                            &mut star,
+                            &mut report,
+                            &mut touched,
+                        );
+                    }
+                }
+                bad = scan_all(&mut w, thr);
             }
         }
         report.ms[4] = c.elapsed().as_secs_f64() * 1e3;

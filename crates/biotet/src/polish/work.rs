@@ -29,6 +29,9 @@ pub(super) struct Work {
     forced: Vec<u8>,
     free: Vec<u32>,
     forced_deg: f64,
+    /// Set for polish's last pass only: an insertion may trade a nearly flat tet for a few just
+    /// below the threshold ([`Work::insert`]).
+    pub rescue_flat: bool,
 }
 
 impl Work {
@@ -46,6 +49,7 @@ impl Work {
             forced: vec![0; n],
             free: Vec::new(),
             forced_deg,
+            rescue_flat: false,
         };
         for t in 0..n {
             for (i, f) in TET_FACES.iter().enumerate() {
