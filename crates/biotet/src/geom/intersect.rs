@@ -1,6 +1,6 @@
 //! Exact intersection tests built from orientation predicates.
 //!
-//! Every decision here is a sign of [`orient3d`] or [`orient2d`] (or an exact comparison of
+//! Every decision here is a sign of [`orient3d`] (the filtered exact one) or [`orient2d`] (or an exact comparison of
 //! coordinates between points already known to be collinear); floating point arithmetic is only
 //! used to *prefer* a projection axis, whose validity is then verified exactly.
 //!
@@ -11,7 +11,8 @@
 //! Local numbering follows [`crate::TRI_EDGES`]: edge `k` of a triangle is the edge opposite its
 //! corner `k`.
 
-use super::predicates::{Sign, orient2d, orient3d};
+use super::filter::orient3d;
+use super::predicates::{Sign, orient2d};
 
 type P3 = [f64; 3];
 type P2 = [f64; 2];

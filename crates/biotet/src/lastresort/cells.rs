@@ -8,8 +8,9 @@
 //! glued. Cells are the connected components of this gluing; each is closed and consistently
 //! oriented by construction.
 
+use crate::geom::filter::orient3d;
 use crate::geom::intersect::{drop_axis, projection_axis};
-use crate::geom::predicates::{Sign, orient2d, orient3d};
+use crate::geom::predicates::{Sign, orient2d};
 use std::cmp::Ordering;
 
 type P3 = [f64; 3];

@@ -16,8 +16,9 @@
 //! a ray chain region to region, so the last region is the one entered more often than left (or
 //! the starting region when all balance), which needs counts only.
 
+use crate::geom::filter::orient3d;
 use crate::geom::intersect::{drop_axis, point_in_triangle_2d, projection_axis};
-use crate::geom::predicates::{Sign, orient2d, orient3d};
+use crate::geom::predicates::{Sign, orient2d};
 use crate::mesh::surface::SurfaceMesh;
 
 /// Where a point lies relative to a surface.

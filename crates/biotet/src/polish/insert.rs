@@ -343,9 +343,12 @@ impl Work {
         // few just below the threshold: every new tet at least half of it (a box folded by
         // round-off kept a 0.00° tet whose cone from one point is at 9.8°). Only last: earlier,
         // such a trade can block a later fix that leaves none below the threshold.
-        let rescued = self.rescue_flat && old.1 < 0.1 * thr && new.1 >= 0.5 * thr;
-        if new.0 > old.0 && new.1 >= old.1 && (new.2 <= old.2 || rescued) {
+        let flat_out = old.1 < 0.1 * thr && new.1 >= 0.5 * thr;
+        if new.0 > old.0 && new.1 >= old.1 && (new.2 <= old.2 || (self.rescue_flat && flat_out)) {
             return Some(ids);
+        }
+        if flat_out && new.0 > old.0 && !self.rescue_flat {
+            self.rescuable.push(t);
         }
         if filled {
             let back = self.cavity(ids);

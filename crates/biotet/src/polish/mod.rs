@@ -269,11 +269,10 @@ pub fn polish(mesh: &mut TetMesh, opts: &PolishOptions) -> PolishReport {
         }
         // Last, the nearly flat tets still there: a point whose tets are all at least half the
         // threshold replaces one even with more of them below the threshold.
-        let flat: Vec<u32> = bad
-            .iter()
-            .filter(|x| x.0 < 0.1 * thr)
-            .map(|x| x.1)
-            .collect();
+        // Only those refused before for the count alone: the others would fail again.
+        let mut flat = std::mem::take(&mut w.rescuable);
+        flat.sort_unstable();
+        flat.dedup();
         if !flat.is_empty() {
             w.rescue_flat = true;
             for t in flat {

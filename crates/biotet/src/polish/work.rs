@@ -32,6 +32,8 @@ pub(super) struct Work {
     /// Set for polish's last pass only: an insertion may trade a nearly flat tet for a few just
     /// below the threshold ([`Work::insert`]).
     pub rescue_flat: bool,
+    /// Tets whose insertion was refused only for that count (the last pass retries these alone).
+    pub rescuable: Vec<u32>,
 }
 
 impl Work {
@@ -50,6 +52,7 @@ impl Work {
             free: Vec::new(),
             forced_deg,
             rescue_flat: false,
+            rescuable: Vec::new(),
         };
         for t in 0..n {
             for (i, f) in TET_FACES.iter().enumerate() {
