@@ -287,22 +287,7 @@ pub fn polish(mesh: &mut TetMesh, opts: &PolishOptions) -> PolishReport {
             }
             w.rescue_flat = false;
             if report.flat_rescued > 0 {
-                bad = scan_all(&mut w, thr);
-                for &(_, t) in bad.clone().iter() {
-                    if w.alive[t as usize] && w.min_angle(t) < thr {
-                        let mut touched = Vec::new();
-                        move_corners(
-                            &mut w,
-                            t,
-                            thr,
-                            &params,
-                            &mut star,
-                            &mut report,
-                            &mut touched,
-                        );
-                    }
-                }
-                bad = scan_all(&mut w, thr);
+                moves_after_points(&mut w, &mut bad, thr, &params, &mut star, &mut report);
             }
         }
         report.ms[4] = c.elapsed().as_secs_f64() * 1e3;
@@ -467,6 +452,20 @@ fn insert_round(
     if !any {
         return false;
     }
+    moves_after_points(w, bad, thr, params, star, report);
+    true
+}
+
+/// After points were added: `bad` rescanned, one round of moves around the tets still bad (the
+/// new points, and those next to them, may now move), and `bad` rescanned again if one moved.
+fn moves_after_points(
+    w: &mut Work,
+    bad: &mut Vec<(f64, u32)>,
+    thr: f64,
+    params: &StepParams,
+    star: &mut Vec<u32>,
+    report: &mut PolishReport,
+) {
     *bad = scan_all(w, thr);
     let mut moved = false;
     for &(_, t) in bad.iter() {
@@ -478,7 +477,6 @@ fn insert_round(
     if moved {
         *bad = scan_all(w, thr);
     }
-    true
 }
 
 /// A hash of `t` and its face neighbours: their corners and the corners' coordinates.
