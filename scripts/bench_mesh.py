@@ -85,8 +85,7 @@ def run_tetgen_binary(surface, switches, tmp, repeat):
     return rows, None, os.path.join(tmp, "tg_input.1.node")
 
 
-def fmt(v, spec):
-    return "–" if v is None else format(v, spec)
+fmt = benchlib.cell
 
 
 def main():

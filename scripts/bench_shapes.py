@@ -176,8 +176,7 @@ def bench(exe, surface, repeat, timeout, tetgen):
 # table
 
 
-def num(v, spec=","):
-    return "–" if v is None or v == "" else format(v, spec)
+num = benchlib.cell
 
 
 def deg(v, digits=1):

@@ -167,6 +167,12 @@ def cgal_mesh3():
     return exe
 
 
+def cell(v, spec=","):
+    """A markdown table cell: '–' for a missing value (None or ''), else `format(v, spec)` (thousands separators
+    by default)."""
+    return "–" if v is None or v == "" else format(v, spec)
+
+
 def median(rows, key):
     """Median of `key` over the rows that have it (None if none has)."""
     vals = [r[key] for r in rows if r.get(key) is not None]

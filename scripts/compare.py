@@ -204,11 +204,7 @@ def write_node_like(src, dst, points):
 # tables
 
 
-def num(v, spec=","):
-    """A table cell: '–' for a missing value, thousands separators for counts."""
-    if v is None or v == "":
-        return "–"
-    return format(v, spec)
+num = benchlib.cell
 
 
 def angle(v, digits):

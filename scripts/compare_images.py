@@ -206,7 +206,7 @@ def main():
                     row["failed"] = str(e).strip().splitlines()[-1][:200] if str(e).strip() else type(e).__name__
                     print(f"{name}: {tool} failed: {row['failed']}", file=sys.stderr)
                 rows.append(row)
-    f = lambda v, s: "–" if v is None else format(v, s)
+    f = benchlib.cell
     dist = lambda d: "–" if d is None else f"{d[0]:.3f} / {d[1]:.3f} ({d[2]:.3f})"
     lines = ["| image | tool | seconds | wall s | peak MB | tets | min dihedral | max dihedral | <10° | <5° "
              "| worst region volume error | distance to the voxel boundary: in→out / out→in (bound), mm | note |",

@@ -87,8 +87,7 @@ def run_tool(exe, tool, surface, d, tmp, n_points):
     raise ValueError(tool)
 
 
-def fmt(v, spec):
-    return "–" if v is None else format(v, spec)
+fmt = benchlib.cell
 
 
 def table(rows):
