@@ -109,8 +109,10 @@ pub struct MeshReport {
     pub n_points: usize,
     /// Input triangles that are not faces of the output mesh.
     pub missing_triangles: usize,
-    /// What boundary recovery did (if it ran).
+    /// What boundary recovery did (if it ran; the last try's report after retries).
     pub recover: Option<RecoverReport>,
+    /// Retries of recovery without the interior nodes near the triangles it left, in order.
+    pub retries: Vec<RetryReport>,
     /// What sliver removal did (if it ran).
     pub improve: Option<ImproveReport>,
     /// What smoothing did (if it ran).
@@ -150,37 +152,125 @@ pub fn mesh_surface<S: Borrow<Sizing>>(
 ) -> Result<(TetMesh, MeshReport), PipelineError> {
     let start = Instant::now();
     let mut report = MeshReport::default();
-    let stage = |report: &mut MeshReport, name: &'static str, clock: Instant| {
-        report.stages.push(StageReport {
-            name,
-            seconds: clock.elapsed().as_secs_f64(),
-        });
-    };
 
     progress("deploying nodes");
     let clock = Instant::now();
-    let mut dep = deploy(surface, sizing.borrow(), &opts.deploy)?;
+    let dep = deploy(surface, sizing.borrow(), &opts.deploy)?;
     drop(sizing);
     report.template = dep.stats.clone();
     report.n_surface_points = dep.n_surface;
     report.n_interior_nodes = dep.interior_regions.len();
     stage(&mut report, "deploy", clock);
 
+    let ns = dep.n_surface;
+    // The nodes are kept for a retry: a surface triangle far larger than the spacing around it
+    // can cross so many tets that no cavity within the bounds holds it (the Schönhardt prism
+    // or two cubes at a twentieth of their size). Without the nodes near it, it can.
+    let retry = (opts.recover.is_some_and(|o| o.allow_interior_steiner)
+        && !dep.interior_regions.is_empty())
+    .then(|| (dep.points.clone(), dep.interior_regions.clone()));
+    // With nodes to clear, the first try skips the wide rounds (seconds where a retry takes
+    // milliseconds); they come last, if clearing does not do.
+    let first = opts.recover.map(|o| RecoverOptions {
+        widen: o.widen && retry.is_none(),
+        ..o
+    });
+    let mut mesh = tetrahedralize(
+        surface,
+        dep.points,
+        dep.interior_regions,
+        ns,
+        first.as_ref(),
+        &mut report,
+        progress,
+    )?;
+    if let (Some((points, regions)), Some(first), Some(last)) = (retry, first, opts.recover) {
+        let clock = Instant::now();
+        let nodes = Nodes {
+            points,
+            regions,
+            ns,
+        };
+        if let Some(m) = recover_again(surface, nodes, [first, last], &mut report, progress)? {
+            mesh = m;
+            stage(&mut report, "retry", clock);
+        }
+    }
+
+    if let Some(o) = &opts.improve {
+        progress("removing slivers");
+        let clock = Instant::now();
+        report.improve = Some(improve(&mut mesh, o));
+        stage(&mut report, "improve", clock);
+    }
+    if let Some(o) = &opts.smooth {
+        progress("smoothing");
+        let clock = Instant::now();
+        report.smooth = Some(smooth(&mut mesh, Some(surface), o)?);
+        stage(&mut report, "smooth", clock);
+    }
+    if let Some(o) = opts.polish.as_ref().filter(|_| opts.recover.is_some()) {
+        progress("polishing");
+        let clock = Instant::now();
+        report.polish = Some(polish(&mut mesh, o));
+        stage(&mut report, "polish", clock);
+    }
+
+    report.missing_triangles = missing_triangles(&mesh, surface);
+    report.n_tets = mesh.tets.len();
+    report.n_points = mesh.points.len();
+    report.seconds_total = start.elapsed().as_secs_f64();
+    Ok((mesh, report))
+}
+
+/// Record a stage's time since `clock`.
+fn stage(report: &mut MeshReport, name: &'static str, clock: Instant) {
+    report.stages.push(StageReport {
+        name,
+        seconds: clock.elapsed().as_secs_f64(),
+    });
+}
+
+/// Node-clearing retries of recovery at most (each doubles the radius around the triangles).
+const MAX_RETRIES: usize = 5;
+
+/// One retry of recovery without the nodes near the triangles it left.
+#[derive(Debug, Clone, Serialize)]
+pub struct RetryReport {
+    /// Interior nodes removed before it.
+    pub nodes_removed: usize,
+    /// Whether it was the last, with recovery's wide rounds (no node left to remove near).
+    pub wide: bool,
+    /// Input triangles still missing after it.
+    pub missing_after: usize,
+}
+
+/// Tetrahedralize the points (surface points first, `ns` of them, then interior nodes with
+/// their regions), label the tets, and recover the boundary when asked.
+fn tetrahedralize(
+    surface: &SurfaceMesh,
+    mut points: Vec<[f64; 3]>,
+    mut regions: Vec<u32>,
+    ns: usize,
+    recover: Option<&RecoverOptions>,
+    report: &mut MeshReport,
+    progress: &mut dyn FnMut(&str),
+) -> Result<TetMesh, PipelineError> {
     progress("tetrahedralizing");
     let clock = Instant::now();
-    if opts.recover.is_some() {
+    if recover.is_some() {
         // Eight corners of a box around everything, outside (region 0): no surface triangle
         // then lies on the convex hull, where a planar facet split otherwise than the hull's
         // faces has no cavity to be recovered in. Only outside tets use them; they go with
         // those after recovery.
-        enclose(&mut dep.points, &mut dep.interior_regions);
+        enclose(&mut points, &mut regions);
     }
     // The triangulation takes the points (no second copy); they come back by vertex number,
     // which is the input order for distinct points.
-    let n_points = dep.points.len();
-    let del = Delaunay::from_points(dep.points)?;
+    let n_points = points.len();
+    let del = Delaunay::from_points(points)?;
     report.n_delaunay_tets = del.n_finite_tets();
-    stage(&mut report, "delaunay", clock);
+    stage(report, "delaunay", clock);
 
     progress("removing outside tets");
     let clock = Instant::now();
@@ -193,7 +283,7 @@ pub fn mesh_surface<S: Borrow<Sizing>>(
             input_of[v as usize] = i as u32;
         }
     }
-    let ns = dep.n_surface as u32;
+    let ns = ns as u32;
     // The finite slots as a bitset with a rank per word: the tets' neighbours come from the
     // triangulation's own adjacency (no face sorting, no per-slot index array).
     let mut finite = vec![0u64; del.n_slots().div_ceil(64)];
@@ -239,7 +329,7 @@ pub fn mesh_surface<S: Borrow<Sizing>>(
                 centroid_region(v.map(|x| points[x as usize]), &locator, scratch)
             } else {
                 let i = v.iter().find(|&&x| x >= ns).copied().unwrap_or(0);
-                dep.interior_regions[(i - ns) as usize]
+                regions[(i - ns) as usize]
             }
         })
         .collect_into_vec(&mut labels);
@@ -247,17 +337,17 @@ pub fn mesh_surface<S: Borrow<Sizing>>(
         .iter()
         .filter(|v| v.iter().filter(|&&x| x < ns).count() >= 2)
         .count();
-    drop((locator, dep.interior_regions));
+    drop((locator, regions));
     // With recovery to follow, every tet is kept: recovery works on the convex hull and labels
     // by flood fill across the recovered surface; the centroid labels stay only where it cannot
     // (triangles left unrecovered). Without it, the outside tets go here.
-    if opts.recover.is_none() {
+    if recover.is_none() {
         keep_labelled(&mut tets, &mut neighbors, &mut labels);
     }
     let mut mesh = compact(points, tets, neighbors, labels);
-    stage(&mut report, "keep inside", clock);
+    stage(report, "keep inside", clock);
 
-    if let Some(o) = &opts.recover {
+    if let Some(o) = recover {
         progress("recovering the boundary");
         let clock = Instant::now();
         report.recover = Some(recover_built(&mut mesh, surface, o)?);
@@ -269,33 +359,118 @@ pub fn mesh_surface<S: Borrow<Sizing>>(
             labels,
         } = mesh;
         mesh = compact(points, tets, neighbors, labels);
-        stage(&mut report, "recover", clock);
+        stage(report, "recover", clock);
     }
+    Ok(mesh)
+}
 
-    if let Some(o) = &opts.improve {
-        progress("removing slivers");
-        let clock = Instant::now();
-        report.improve = Some(improve(&mut mesh, o));
-        stage(&mut report, "improve", clock);
-    }
-    if let Some(o) = &opts.smooth {
-        progress("smoothing");
-        let clock = Instant::now();
-        report.smooth = Some(smooth(&mut mesh, Some(surface), o)?);
-        stage(&mut report, "smooth", clock);
-    }
-    if let Some(o) = opts.polish.as_ref().filter(|_| opts.recover.is_some()) {
-        progress("polishing");
-        let clock = Instant::now();
-        report.polish = Some(polish(&mut mesh, o));
-        stage(&mut report, "polish", clock);
-    }
+/// The points of a tetrahedralization: `ns` surface points, then interior nodes with their
+/// regions.
+struct Nodes {
+    points: Vec<[f64; 3]>,
+    regions: Vec<u32>,
+    ns: usize,
+}
 
-    report.missing_triangles = missing_triangles(&mesh, surface);
-    report.n_tets = mesh.tets.len();
-    report.n_points = mesh.points.len();
-    report.seconds_total = start.elapsed().as_secs_f64();
-    Ok((mesh, report))
+/// While triangles are missing: remove the interior nodes near them (balls doubling from a
+/// quarter of each triangle's size) and tetrahedralize and recover again with `opts[0]`; when no
+/// node is left to remove near them, or after [`MAX_RETRIES`], once more with `opts[1]` (the
+/// wide rounds). The last mesh, or `None` when recovery left nothing missing.
+fn recover_again(
+    surface: &SurfaceMesh,
+    mut nodes: Nodes,
+    opts: [RecoverOptions; 2],
+    report: &mut MeshReport,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Option<TetMesh>, PipelineError> {
+    let mut mesh = None;
+    let mut radius = 0.25;
+    let mut wide = false;
+    let span = extent(&nodes.points);
+    while !wide && report.recover.as_ref().is_some_and(|r| r.missing_after > 0) {
+        let mut removed = 0;
+        while report.retries.len() < MAX_RETRIES {
+            let balls = unrecovered_balls(report.recover.as_ref(), radius);
+            removed = clear_nodes(&mut nodes, &balls);
+            radius *= 2.0;
+            if removed > 0 || balls.iter().all(|b| b.1 > span) {
+                break;
+            }
+        }
+        wide = removed == 0;
+        progress("recovering again without the nodes near the missing triangles");
+        let mut again = MeshReport::default();
+        mesh = Some(tetrahedralize(
+            surface,
+            nodes.points.clone(),
+            nodes.regions.clone(),
+            nodes.ns,
+            Some(&opts[wide as usize]),
+            &mut again,
+            &mut |_| {},
+        )?);
+        report.retries.push(RetryReport {
+            nodes_removed: removed,
+            wide,
+            missing_after: again.recover.as_ref().map_or(0, |r| r.missing_after),
+        });
+        report.n_delaunay_tets = again.n_delaunay_tets;
+        report.n_centroid_tests = again.n_centroid_tests;
+        report.recover = again.recover;
+    }
+    Ok(mesh)
+}
+
+/// Balls around the triangles recovery left (centroid, `factor` times the farthest corner's
+/// distance), as (centre, radius).
+fn unrecovered_balls(r: Option<&RecoverReport>, factor: f64) -> Vec<([f64; 3], f64)> {
+    r.map_or(Vec::new(), |r| {
+        r.unrecovered
+            .iter()
+            .map(|u| {
+                let c = [0, 1, 2].map(|k| u.corners.iter().map(|p| p[k]).sum::<f64>() / 3.0);
+                let d = u
+                    .corners
+                    .iter()
+                    .map(|p| crate::geom::vec3::norm(crate::geom::vec3::sub(*p, c)))
+                    .fold(0.0, f64::max);
+                (c, factor * d)
+            })
+            .collect()
+    })
+}
+
+/// Remove the interior nodes inside any of the balls; returns how many.
+fn clear_nodes(nodes: &mut Nodes, balls: &[([f64; 3], f64)]) -> usize {
+    let Nodes {
+        points,
+        regions,
+        ns,
+    } = nodes;
+    let ns = *ns;
+    let before = points.len();
+    let mut k = ns;
+    for i in ns..points.len() {
+        let p = points[i];
+        let near = balls.iter().any(|(c, r)| {
+            let d = crate::geom::vec3::sub(p, *c);
+            crate::geom::vec3::dot(d, d) < r * r
+        });
+        if !near {
+            points[k] = p;
+            regions[k - ns] = regions[i - ns];
+            k += 1;
+        }
+    }
+    points.truncate(k);
+    regions.truncate(k - ns);
+    before - k
+}
+
+/// The largest extent of the points' bounding box.
+fn extent(points: &[[f64; 3]]) -> f64 {
+    let (lo, hi) = crate::geom::vec3::points_bbox(points.iter());
+    (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max)
 }
 
 /// Region of a tet by its centroid; if the centroid lies exactly on the surface, other interior

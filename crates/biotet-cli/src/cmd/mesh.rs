@@ -450,6 +450,15 @@ pub fn run(a: Args) -> Result<ExitCode> {
                 r.steiner_points
             );
         }
+        if !report.retries.is_empty() {
+            let removed: usize = report.retries.iter().map(|r| r.nodes_removed).sum();
+            text += &format!(
+                "recover: tried again {} times without the interior nodes near the triangles \
+                 left ({removed} nodes removed of {}): the mesh is coarser there than asked\n",
+                report.retries.len(),
+                report.n_interior_nodes
+            );
+        }
         text += &format!(
             "min dihedral {:.3}°, max {:.3}°, tets below 10°: {}, mean q {:.3}",
             quality.min_dihedral_deg.unwrap_or(f64::NAN),

@@ -119,6 +119,11 @@ pub struct RecoverOptions {
     /// Each cell is first searched with this quality threshold ηe (fewer candidates, better
     /// tets), then with [`SearchOptions::min_quality`] if that fails; at or below it, one search.
     pub first_quality: f64,
+    /// After a Steiner round without progress, carve wider cavities and search longer (see
+    /// [`WIDE_GROW`]). The pipeline's first try goes without: it clears the nodes around what
+    /// is left and tries again instead, which costs milliseconds where wide cavities of a
+    /// triangle far larger than the spacing cost seconds.
+    pub widen: bool,
 }
 
 /// The crossed-tets cavity is tried only up to this many tets (larger ones go straight to the
@@ -150,6 +155,7 @@ impl Default for RecoverOptions {
             max_tries: 1,
             remove_outside: true,
             first_quality: 0.05,
+            widen: true,
         }
     }
 }
@@ -324,7 +330,7 @@ fn recover_checked(
             r.tries.clear();
             r.run();
             let after = r.count_missing();
-            if after == 0 || (after == before && r.wide) {
+            if after == 0 || (after == before && (r.wide || !opts.widen)) {
                 break;
             }
             // Stuck with small cavities: the next rounds carve wider ones and search longer,
