@@ -152,3 +152,28 @@ fn a_size_far_finer_than_the_triangles_still_meshes() {
         );
     }
 }
+
+/// When recovery fails (here forbidden new points and node removal by `--no-steiner`), the
+/// error names recovery's own failures first: the triangles lost afterwards, with the outside
+/// tets the leaking labels took, were listed first as "a corner is not a mesh point".
+#[test]
+fn a_failed_recovery_names_its_own_failures_first() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/shapes");
+    let s = root.join("gen_two_cubes_apart.off");
+    let out = dir.path().join("out.vtu");
+    let (s, o) = (s.to_str().unwrap(), out.to_str().unwrap());
+    let m = biotet(&["mesh", s, "-o", o, "--size", "0.1225", "--no-steiner", "-q"]);
+    assert_eq!(m.status.code(), Some(1));
+    assert!(!out.exists());
+    let err = String::from_utf8_lossy(&m.stderr);
+    let first = err
+        .lines()
+        .find(|l| l.trim_start().starts_with("triangle "))
+        .unwrap_or_else(|| panic!("no triangle listed: {err}"));
+    assert!(
+        !first.contains("not a mesh point") && !first.contains("removed with the outside"),
+        "{first}"
+    );
+    assert!(err.contains("removed with the outside tets"), "{err}");
+}

@@ -341,6 +341,9 @@ fn recover_checked(
             }
         }
     }
+    // What recovery itself left: the list below names these first. Through them the region
+    // labels can leak, and removing the outside then takes the surface's other triangles too.
+    let left: FxHashSet<u32> = r.missing_mapped().collect();
     r.compact();
     // Also sets the final `is_present`.
     let (removed, conflicts) = r.relabel();
@@ -356,14 +359,20 @@ fn recover_checked(
                 triangle: s,
                 corners,
                 min_angle_deg: min_angle_3d_deg(&corners),
-                reason: r
-                    .reason
-                    .get(&(s as u32))
-                    .cloned()
-                    .unwrap_or_else(|| "a corner is not a mesh point".to_string()),
+                reason: r.reason.get(&(s as u32)).cloned().unwrap_or_else(|| {
+                    if r.tri_map[s].is_some() && !left.contains(&(s as u32)) {
+                        "removed with the outside tets (the region labels leaked through the \
+                         triangles recovery left)"
+                            .to_string()
+                    } else {
+                        "a corner is not a mesh point".to_string()
+                    }
+                }),
             });
         }
     }
+    // Recovery's own failures first: the others follow from them.
+    unrecovered.sort_by_key(|u| (!left.contains(&(u.triangle as u32)), u.triangle));
     let mut ms: Vec<f64> = r.call_ms.clone();
     ms.sort_by(f64::total_cmp);
     let mut nodes = r.call_nodes.clone();
