@@ -151,6 +151,52 @@ fn a_size_far_finer_than_the_triangles_still_meshes() {
             String::from_utf8_lossy(&c.stdout)
         );
     }
+    // trimesh's box with a copy half its size inside (two regions), at a twentieth of the
+    // diagonal: exit 1 after about 110 s before.
+    let nested = dir.path().join("box_in_box.off");
+    std::fs::write(&nested, box_in_box(&root.join("tm_box.off"))).unwrap();
+    let (s, out) = (nested.to_str().unwrap(), dir.path().join("box_in_box.vtu"));
+    let m = biotet(&[
+        "mesh",
+        s,
+        "-o",
+        out.to_str().unwrap(),
+        "--size",
+        "0.0866",
+        "-q",
+    ]);
+    assert!(m.status.success(), "{}", String::from_utf8_lossy(&m.stderr));
+    let c = biotet(&["check", out.to_str().unwrap(), "--surface", s]);
+    assert!(c.status.success(), "box in a box: check fails");
+}
+
+/// The OFF surface at `path` and a copy of it scaled by a half about its centroid.
+fn box_in_box(path: &Path) -> String {
+    let text = std::fs::read_to_string(path).unwrap();
+    let w: Vec<&str> = text.split_whitespace().collect();
+    let (n, m): (usize, usize) = (w[1].parse().unwrap(), w[2].parse().unwrap());
+    let p: Vec<[f64; 3]> = (0..n)
+        .map(|i| [0, 1, 2].map(|k| w[4 + 3 * i + k].parse().unwrap()))
+        .collect();
+    let c = [0, 1, 2].map(|k| p.iter().map(|q| q[k]).sum::<f64>() / n as f64);
+    let inner: Vec<[f64; 3]> = p
+        .iter()
+        .map(|q| [0, 1, 2].map(|k| c[k] + 0.5 * (q[k] - c[k])))
+        .collect();
+    let mut out = format!("OFF\n{} {} 0\n", 2 * n, 2 * m);
+    for q in p.iter().chain(&inner) {
+        out += &format!("{:?} {:?} {:?}\n", q[0], q[1], q[2]);
+    }
+    let t0 = 4 + 3 * n;
+    for shift in [0, n] {
+        for j in 0..m {
+            let t: Vec<usize> = (1..4)
+                .map(|k| w[t0 + 4 * j + k].parse::<usize>().unwrap() + shift)
+                .collect();
+            out += &format!("3 {} {} {}\n", t[0], t[1], t[2]);
+        }
+    }
+    out
 }
 
 /// When recovery fails (here forbidden new points and node removal by `--no-steiner`), the
