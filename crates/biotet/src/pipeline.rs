@@ -387,10 +387,14 @@ fn recover_again(
     let mut radius = 0.25;
     let mut wide = false;
     let span = extent(&nodes.points);
-    while !wide && report.recover.as_ref().is_some_and(|r| r.missing_after > 0) {
+    while let Some(left) = report
+        .recover
+        .as_ref()
+        .filter(|r| !wide && r.missing_after > 0)
+    {
         let mut removed = 0;
         while report.retries.len() < MAX_RETRIES {
-            let balls = unrecovered_balls(report.recover.as_ref(), radius);
+            let balls = unrecovered_balls(left, radius);
             removed = clear_nodes(&mut nodes, &balls);
             radius *= 2.0;
             if removed > 0 || balls.iter().all(|b| b.1 > span) {
@@ -423,21 +427,19 @@ fn recover_again(
 
 /// Balls around the triangles recovery left (centroid, `factor` times the farthest corner's
 /// distance), as (centre, radius).
-fn unrecovered_balls(r: Option<&RecoverReport>, factor: f64) -> Vec<([f64; 3], f64)> {
-    r.map_or(Vec::new(), |r| {
-        r.unrecovered
-            .iter()
-            .map(|u| {
-                let c = [0, 1, 2].map(|k| u.corners.iter().map(|p| p[k]).sum::<f64>() / 3.0);
-                let d = u
-                    .corners
-                    .iter()
-                    .map(|p| crate::geom::vec3::norm(crate::geom::vec3::sub(*p, c)))
-                    .fold(0.0, f64::max);
-                (c, factor * d)
-            })
-            .collect()
-    })
+fn unrecovered_balls(r: &RecoverReport, factor: f64) -> Vec<([f64; 3], f64)> {
+    r.unrecovered
+        .iter()
+        .map(|u| {
+            let c = [0, 1, 2].map(|k| u.corners.iter().map(|p| p[k]).sum::<f64>() / 3.0);
+            let d = u
+                .corners
+                .iter()
+                .map(|p| crate::geom::vec3::norm(crate::geom::vec3::sub(*p, c)))
+                .fold(0.0, f64::max);
+            (c, factor * d)
+        })
+        .collect()
 }
 
 /// Remove the interior nodes inside any of the balls; returns how many.
@@ -449,13 +451,23 @@ fn clear_nodes(nodes: &mut Nodes, balls: &[([f64; 3], f64)]) -> usize {
     } = nodes;
     let ns = *ns;
     let before = points.len();
+    // The balls' bounding box first: most nodes are far from every ball.
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for (c, r) in balls {
+        for k in 0..3 {
+            lo[k] = lo[k].min(c[k] - r);
+            hi[k] = hi[k].max(c[k] + r);
+        }
+    }
     let mut k = ns;
     for i in ns..points.len() {
         let p = points[i];
-        let near = balls.iter().any(|(c, r)| {
-            let d = crate::geom::vec3::sub(p, *c);
-            crate::geom::vec3::dot(d, d) < r * r
-        });
+        let near = (0..3).all(|a| p[a] >= lo[a] && p[a] <= hi[a])
+            && balls.iter().any(|(c, r)| {
+                let d = crate::geom::vec3::sub(p, *c);
+                crate::geom::vec3::dot(d, d) < r * r
+            });
         if !near {
             points[k] = p;
             regions[k - ns] = regions[i - ns];
@@ -621,11 +633,7 @@ fn enclose(points: &mut Vec<[f64; 3]>, regions: &mut Vec<u32>) {
         return;
     }
     let (lo, hi) = crate::geom::vec3::points_bbox(points.iter());
-    let extent = (0..3)
-        .map(|k| hi[k] - lo[k])
-        .fold(0.0, f64::max)
-        .max(1e-300);
-    let margin = ENCLOSE_MARGIN * extent;
+    let margin = ENCLOSE_MARGIN * extent(points).max(1e-300);
     for i in 0..8 {
         let pick = |k: usize| {
             if i >> k & 1 == 0 {
