@@ -100,7 +100,10 @@ def main(argv: list[str] | None = None) -> int:
 
     from dask.distributed import Client, LocalCluster
 
-    out = Path(a.out)
+    # Absolute paths: workers of a remote scheduler run elsewhere (another directory, another
+    # node of a shared file system), where the client's relative paths mean nothing.
+    out = Path(a.out).resolve()
+    inputs = [str(Path(p).resolve()) for p in a.inputs]
     out.mkdir(parents=True, exist_ok=True)
     options: dict = {"size": a.size} if a.size else {}
     if a.keep_labels:
@@ -115,8 +118,8 @@ def main(argv: list[str] | None = None) -> int:
                                dashboard_address=None)
         client = Client(cluster)
     try:
-        futures = [client.submit(mesh_one, str(p), str(out), options, key=f"mesh-{i}-{subject_name(str(p))}")
-                   for i, p in enumerate(a.inputs)]
+        futures = [client.submit(mesh_one, p, str(out), options, key=f"mesh-{i}-{subject_name(p)}")
+                   for i, p in enumerate(inputs)]
         rows = client.gather(futures)
     finally:
         client.close()

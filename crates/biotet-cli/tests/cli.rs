@@ -334,6 +334,45 @@ fn check_fails_when_a_surface_triangle_is_missing() {
     assert!(String::from_utf8_lossy(&out.stdout).contains("INVALID"));
 }
 
+/// A file of triangles and no tets (a surface; a 2D mesh written as .vtu, which is written only)
+/// is refused by name, not reported as an invalid mesh of no tets. Found by the docs test:
+/// `biotet check holey_s.vtu` said "INVALID: 1901 points, 0 tets".
+#[test]
+fn check_refuses_a_file_of_triangles_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let smoothed = dir.path().join("holey_s.vtu");
+    let poly = root().join("examples/plane/holey.poly");
+    let mesh = dir.path().join("holey.mesh");
+    assert!(
+        biotet(&["mesh", s(&poly), "-o", s(&mesh), "-q"])
+            .status
+            .success()
+    );
+    let out = biotet(&[
+        "smooth",
+        s(&mesh),
+        "--surface",
+        s(&poly),
+        "-o",
+        s(&smoothed),
+        "-q",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    for file in [smoothed, root().join("tests/data/shapes/tm_box.off")] {
+        let out = biotet(&["check", s(&file)]);
+        assert_eq!(out.status.code(), Some(2), "{}", file.display());
+        let e = stderr(&out);
+        assert_eq!(e.trim_end().lines().count(), 1, "{e}");
+        assert!(e.contains(s(&file)) && e.contains("no tets"), "{e}");
+    }
+    // The 2D mesh as .mesh is checked as a 2D mesh.
+    assert!(
+        biotet(&["check", s(&mesh), "--surface", s(&poly)])
+            .status
+            .success()
+    );
+}
+
 #[test]
 fn json_errors_are_json_too() {
     let out = biotet(&["quality", "/nonexistent/m.vtu", "--json"]);

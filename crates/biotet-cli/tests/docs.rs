@@ -1,10 +1,84 @@
 //! The documentation cannot drift from the tool: every `biotet` command line in a `sh` block of
 //! the README and of docs/*.md must be accepted by the argument parser as written (every
-//! command, option and value exists), and every command's `--help` ends with examples.
+//! command, option and value exists), every line of those blocks runs as written (but the few
+//! listed in [`NOT_RUN`], with why), and every command's `--help` ends with examples.
 
 mod support;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 use support::*;
+
+/// Lines of the docs' `sh` blocks that [`every_documented_shell_line_runs`] does not run, by
+/// prefix, with why. Each prefix must still match a line (the list cannot rot); every other
+/// line of every `sh` block is run.
+const NOT_RUN: &[(&str, &str)] = &[
+    ("scripts/test.sh", "the test suite this test is part of"),
+    (
+        "cargo install ",
+        "a second release build of the binary this test runs",
+    ),
+    (
+        "cargo build --release",
+        "cargo test built the binary this test runs",
+    ),
+    (
+        "pip install ",
+        "scripts/test.sh installs the Python package and its pytest suite runs",
+    ),
+    (
+        "(cd crates/biotet-py && maturin build",
+        "scripts/test.sh builds and installs the Python package",
+    ),
+    (
+        "python examples/cohort_dask.py",
+        "run by the Python suite (crates/biotet-py/tests/test_docs.py), which has Dask",
+    ),
+    (
+        "python3 scripts/compare.py",
+        "a benchmark: needs TetGen, Gmsh, CGAL, fTetWild and MMG, and minutes",
+    ),
+    (
+        "python3 scripts/bench_",
+        "a benchmark beside anchors (TetGen, MMG, pytetwild) CI does not install",
+    ),
+];
+
+/// The lines of the `sh` blocks of `text` (`\` continuations joined), with their line numbers.
+fn sh_lines(text: &str) -> Vec<(usize, String)> {
+    let mut out: Vec<(usize, String)> = Vec::new();
+    let mut in_sh = false;
+    let mut open = false;
+    for (i, line) in text.lines().enumerate() {
+        let t = line.trim_start();
+        if t.starts_with("```") {
+            in_sh = !in_sh && t.trim_start_matches('`').trim() == "sh";
+            open = false;
+            continue;
+        }
+        if !in_sh {
+            continue;
+        }
+        let (body, cont) = match line.trim_end().strip_suffix('\\') {
+            Some(b) => (b.to_string(), true),
+            None => (line.to_string(), false),
+        };
+        match out.last_mut() {
+            Some(last) if open => last.1.push_str(&body),
+            _ => out.push((i + 1, body)),
+        }
+        open = cont;
+    }
+    out
+}
+
+/// Why a documented line is not run, if it is one of [`NOT_RUN`].
+fn not_run(line: &str) -> Option<&'static str> {
+    let t = line.trim_start();
+    NOT_RUN
+        .iter()
+        .find(|(p, _)| t.starts_with(p))
+        .map(|&(_, why)| why)
+}
 
 /// The `biotet` command lines of the `sh` blocks of `text`, with their line numbers:
 /// comments and redirections cut, `cargo run … --` read as `biotet`.
@@ -138,4 +212,134 @@ fn every_command_help_ends_with_examples() {
             );
         }
     }
+}
+
+/// A scratch directory that sees the repository's `tests/` and `examples/` (the paths the docs
+/// use), with the inputs the cohort script of docs/cohorts.md expects.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("biotet-docs-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(dir.join("subjects")).unwrap();
+    std::fs::create_dir_all(dir.join("meshes")).unwrap();
+    let root = root().canonicalize().unwrap();
+    for d in ["tests", "examples"] {
+        std::os::unix::fs::symlink(root.join(d), dir.join(d)).unwrap();
+    }
+    std::os::unix::fs::symlink(
+        root.join("tests/data/brain_20k.stl"),
+        dir.join("subjects/brain_20k.stl"),
+    )
+    .unwrap();
+    dir
+}
+
+/// The `-o` output of a documented `biotet` line, if it writes a mesh.
+fn mesh_output(line: &str) -> Option<String> {
+    let w = words(line.split(" #").next().unwrap_or(""));
+    let command = w.get(1)?.as_str();
+    if !matches!(
+        command,
+        "mesh" | "remesh" | "smooth" | "recover" | "improve"
+    ) {
+        return None;
+    }
+    let i = w.iter().position(|x| x == "-o" || x == "--output")?;
+    let o = w.get(i + 1)?;
+    // A 2D mesh (from a PSLG) written as .vtu is written only: `check` refuses to read it.
+    let planar = w.iter().any(|x| x.ends_with(".poly"));
+    let skip = o.contains('$') || (planar && o.ends_with(".vtu"));
+    (!skip).then(|| o.clone())
+}
+
+/// Every line of the `sh` blocks of the README and of docs/*.md runs as written, in document
+/// order (README first, so the docs' later lines find the meshes it wrote), in one scratch
+/// directory, `biotet` being the binary under test (`cargo run --release -p biotet-cli --` read
+/// as `biotet`); each mesh a line writes passes `biotet check`.
+#[test]
+fn every_documented_shell_line_runs() {
+    let root = root();
+    let mut files = vec![root.join("README.md")];
+    let mut docs: Vec<_> = std::fs::read_dir(root.join("docs"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "md"))
+        .collect();
+    docs.sort();
+    files.extend(docs);
+    let dir = scratch("run");
+    let bin = Path::new(env!("CARGO_BIN_EXE_biotet"));
+    let path = format!(
+        "{}:{}",
+        bin.parent().unwrap().display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+    let mut used = vec![false; NOT_RUN.len()];
+    let mut ran = 0;
+    let mut failed = Vec::new();
+    for f in &files {
+        let text = std::fs::read_to_string(f).unwrap();
+        let name = f.file_name().unwrap().to_string_lossy().into_owned();
+        // One shell for a file's lines, so a block's variables carry to its next lines.
+        let mut script = String::from("set -e -o pipefail\n");
+        let mut lines = Vec::new();
+        for (n, line) in sh_lines(&text) {
+            let t = line.trim();
+            if t.is_empty() || t.starts_with('#') {
+                continue;
+            }
+            if let Some(why) = not_run(t) {
+                let k = NOT_RUN.iter().position(|(_, w)| *w == why).unwrap();
+                used[k] = true;
+                continue;
+            }
+            let t = match t.strip_prefix("cargo run --release -p biotet-cli -- ") {
+                Some(rest) => format!("biotet {rest}"),
+                None => t.to_string(),
+            };
+            script.push_str(&format!("echo '>> {name}:{n}' >&2\n{t}\n"));
+            lines.push((n, t));
+        }
+        if lines.is_empty() {
+            continue;
+        }
+        let out = Command::new("bash")
+            .arg("-c")
+            .arg(&script)
+            .current_dir(&dir)
+            .env("PATH", &path)
+            .env("SLURM_ARRAY_TASK_ID", "0")
+            .output()
+            .unwrap();
+        ran += lines.len();
+        if !out.status.success() {
+            let err = stderr(&out);
+            let at = err.rsplit(">> ").next().unwrap_or("").to_string();
+            failed.push(format!("{name}: stopped at {at}"));
+            continue;
+        }
+        for (n, t) in &lines {
+            let Some(o) = mesh_output(t) else { continue };
+            let check = Command::new(bin)
+                .args(["check", &o])
+                .current_dir(&dir)
+                .output()
+                .unwrap();
+            if !check.status.success() {
+                failed.push(format!(
+                    "{name}:{n}: {o} fails `biotet check`: {}",
+                    String::from_utf8_lossy(&check.stdout)
+                ));
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(failed.is_empty(), "{}", failed.join("\n"));
+    for (k, (p, _)) in NOT_RUN.iter().enumerate() {
+        assert!(
+            used[k],
+            "NOT_RUN lists `{p}`, which no documented line starts with any more"
+        );
+    }
+    // The README's main job and quick start, the view and 2D examples, the Slurm job line.
+    assert!(ran >= 15, "only {ran} documented lines ran");
 }

@@ -37,6 +37,14 @@ pub fn run(a: Args) -> Result<ExitCode> {
         }
         return super::plane::check_cmd(&a.mesh, a.surfaces.first().map(|p| p.as_path()), a.common);
     }
+    // A file of triangles only would read as a mesh of no tets, "invalid" for no stated reason.
+    if biotet_io::mesh_kind(&a.mesh)? == biotet_io::MeshKind::Surface {
+        anyhow::bail!(
+            "{}: holds triangles and no tets (a surface, or a 2D mesh written as .vtu, which is \
+             written only); `biotet check` reads tet meshes, and 2D meshes from .mesh or .node/.ele",
+            a.mesh.display()
+        );
+    }
     let stage = Stage::start(a.common.quiet, format!("reading {}", a.mesh.display()));
     let mesh = super::input::tet_mesh(&a.mesh, a.common)?;
     let surface = if a.surfaces.is_empty() {
