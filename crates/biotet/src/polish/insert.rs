@@ -2,7 +2,8 @@
 //!
 //! The cavity is the tet and its unforced face neighbours of the same label, or, when that fails,
 //! every unforced tet of its label sharing an edge with it, or else the face cavity with its
-//! unforced face neighbours of the label (a cavity with an interior point is not tried).
+//! unforced face neighbours of the label (a cavity with an interior point is not tried). A
+//! nearly flat tet's last chance (polish's rescue pass) starts from two rings of face neighbours.
 //! Boundary and interface faces are never crossed, so they stay on the cavity's shell.
 //! The candidates are the tet's centroid and circumcentre, the centroids of the cavity's tets, the
 //! midpoints between the tet's centroid and theirs, the shell's vertex centroid, and points pushed
@@ -52,6 +53,33 @@ impl Work {
     ) -> Option<Vec<u32>> {
         let label = self.labels[t as usize];
         let faces = self.with_face_neighbours(t);
+        // A nearly flat tet's last chance (rare: one on wm_20k) starts from two rings of face
+        // neighbours: the more room around the new point, the fewer of its tets below the
+        // threshold. A randomly turned box whose only fill of its corners has a flat tet got,
+        // from the tet's edge cavity, a cone with four tets at 9.8°; coned over the whole box,
+        // every tet is above 11.9°.
+        if self.rescue_flat {
+            let mut wide = faces.clone();
+            for _ in 0..2 {
+                for s in wide.clone() {
+                    for n in self.nb[s as usize] {
+                        if n != NO_NEIGHBOR
+                            && self.labels[n as usize] == label
+                            && !self.is_forced(n)
+                        {
+                            wide.push(n);
+                        }
+                    }
+                }
+                wide.sort_unstable();
+                wide.dedup();
+            }
+            if wide != faces
+                && let Some(ids) = self.insert_into(t, wide, thr, searcher, rp, sp, star)
+            {
+                return Some(ids);
+            }
+        }
         if let Some(ids) = self.insert_into(t, faces.clone(), thr, searcher, rp, sp, star) {
             return Some(ids);
         }

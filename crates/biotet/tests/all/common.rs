@@ -137,6 +137,14 @@ pub fn load_stl(name: &str) -> SurfaceMesh {
     s
 }
 
+/// A surface of the shape corpus (`tests/data/shapes`), as one closed region.
+pub fn load_shape(name: &str) -> SurfaceMesh {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../tests/data/shapes/");
+    biotet_io::read_surface(std::path::Path::new(&format!("{path}{name}")))
+        .expect("shape corpus")
+        .mesh
+}
+
 /// `n` SplitMix64 points in the unit cube [0, 1)^3, reproducible from `seed`.
 pub fn random_points(n: usize, mut seed: u64) -> Vec<[f64; 3]> {
     let mut next = move || {

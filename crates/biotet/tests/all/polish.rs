@@ -277,3 +277,32 @@ fn polish_refills_tets_above_165_degrees() {
     let c = check(&on, Some(&surface));
     assert!(c.valid, "{c}");
 }
+
+/// trimesh's randomly turned box (tests/data/shapes/tm_box_random.off): the only fill of its
+/// eight corners, as the pipeline finds it, has a flat tet (0.00°). Polish's last pass replaces
+/// it by a point: from the tet's edge cavity, a cone with four tets at 9.8°; over the whole box
+/// (two rings of face neighbours), every tet at 11.9°.
+#[test]
+fn polish_rescues_a_flat_tet_of_a_thin_box_with_every_tet_above_the_threshold() {
+    let s = crate::common::load_shape("tm_box_random.off");
+    let mut tets: Vec<[u32; 4]> = vec![
+        [7, 5, 4, 0],
+        [1, 2, 0, 7],
+        [3, 2, 1, 7],
+        [7, 1, 5, 0],
+        [4, 0, 2, 7],
+        [6, 2, 7, 4],
+        [6, 3, 7, 2],
+    ];
+    orient_all(&s.points, &mut tets);
+    let mut m = TetMesh::new(s.points.clone(), tets, vec![1; 7]);
+    assert!((0..7).any(|t| min_deg(&m, t) < 0.01), "the flat tet");
+    let r = polish(&mut m, &PolishOptions::default());
+    assert_eq!(r.flat_rescued, 1, "{r:?}");
+    assert_eq!(r.n_bad_after, 0, "{r:?}");
+    assert_eq!(m.points.len(), 9);
+    assert_all_positive(&m);
+    let c = check(&m, Some(&s));
+    assert!(c.valid, "{c}");
+    assert!((0..m.tets.len()).all(|t| min_deg(&m, t) >= 11.9));
+}
