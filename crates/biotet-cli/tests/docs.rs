@@ -343,3 +343,32 @@ fn every_documented_shell_line_runs() {
     // The README's main job and quick start, the view and 2D examples, the Slurm job line.
     assert!(ran >= 15, "only {ran} documented lines ran");
 }
+
+/// Every fenced block of the README and docs/*.md names its language, so no command hides from
+/// the tests above in an untagged block (one in docs/benchmarks.md did).
+#[test]
+fn every_code_block_names_its_language() {
+    let root = root();
+    let mut files = vec![root.join("README.md")];
+    files.extend(
+        std::fs::read_dir(root.join("docs"))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "md")),
+    );
+    let mut bad = Vec::new();
+    for f in &files {
+        let text = std::fs::read_to_string(f).unwrap();
+        let mut open = false;
+        for (i, line) in text.lines().enumerate() {
+            let Some(rest) = line.trim_start().strip_prefix("```") else {
+                continue;
+            };
+            if !open && rest.trim().is_empty() {
+                bad.push(format!("{}:{}", f.display(), i + 1));
+            }
+            open = !open;
+        }
+    }
+    assert!(bad.is_empty(), "untagged code blocks: {}", bad.join(", "));
+}
