@@ -475,6 +475,15 @@ def tm_box_random():
     return b.vertices, b.faces
 
 
+def tm_capsule_turned():
+    """trimesh's long thin capsule turned by a random rotation (numpy seed 3): its bounding box is many times its
+    volume, and its pole triangles far smaller than the rest (the template's grid spacing follows the smallest size)."""
+    import trimesh
+    c = trimesh.creation.capsule(height=5.0, radius=0.2, count=[16, 16])
+    c.apply_transform(trimesh.transformations.random_rotation_matrix(np.random.default_rng(3).random(3)))
+    return c.vertices, c.faces
+
+
 def gen_tetrahedron():
     return np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float), np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
 
@@ -697,6 +706,12 @@ SHAPES = {
     "tm_thin_torus": (tm("torus", major_radius=1.0, minor_radius=0.05, major_sections=64, minor_sections=12),
                       "trimesh {trimesh} creation.torus(1, 0.05, 64, 12)", "generated",
                       "thin tube (diameter a tenth of its ring): no room for template nodes"),
+    "tm_capsule_turned": (tm_capsule_turned, "trimesh {trimesh} creation.capsule(height=5, radius=0.2, count=[16,16]), "
+                          "random rotation (seed 3)", "generated",
+                          "turned long capsule: bounding box far larger than the solid, tiny pole triangles"),
+    "tm_hair_torus": (tm("torus", major_radius=1.0, minor_radius=0.001, major_sections=64, minor_sections=8),
+                      "trimesh {trimesh} creation.torus(1, 0.001, 64, 8)", "generated",
+                      "hair-thin ring (tube a thousandth of the ring): triangles 120 times longer than wide"),
     "tm_box_random": (tm_box_random, "trimesh {trimesh} creation.box, random extents and rotation (seed 1)", "generated",
                       "box faces folded by round-off along their diagonals"),
     "tm_icosphere": (tm("icosphere", subdivisions=3), "trimesh {trimesh} creation.icosphere(subdivisions=3)",
