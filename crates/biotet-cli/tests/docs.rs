@@ -129,17 +129,23 @@ fn words(s: &str) -> Vec<String> {
     out
 }
 
-#[test]
-fn every_documented_command_line_parses() {
+/// The README and docs/*.md, in that order (docs sorted by name).
+fn doc_files() -> Vec<PathBuf> {
     let root = root();
-    let mut files = vec![root.join("README.md")];
     let mut docs: Vec<_> = std::fs::read_dir(root.join("docs"))
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_some_and(|e| e == "md"))
         .collect();
     docs.sort();
+    let mut files = vec![root.join("README.md")];
     files.extend(docs);
+    files
+}
+
+#[test]
+fn every_documented_command_line_parses() {
+    let files = doc_files();
     let mut checked = 0;
     let mut bad = Vec::new();
     for f in &files {
@@ -257,15 +263,7 @@ fn mesh_output(line: &str) -> Option<String> {
 /// as `biotet`); each mesh a line writes passes `biotet check`.
 #[test]
 fn every_documented_shell_line_runs() {
-    let root = root();
-    let mut files = vec![root.join("README.md")];
-    let mut docs: Vec<_> = std::fs::read_dir(root.join("docs"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "md"))
-        .collect();
-    docs.sort();
-    files.extend(docs);
+    let files = doc_files();
     let dir = scratch("run");
     let bin = Path::new(env!("CARGO_BIN_EXE_biotet"));
     let path = format!(
@@ -348,14 +346,7 @@ fn every_documented_shell_line_runs() {
 /// the tests above in an untagged block (one in docs/benchmarks.md did).
 #[test]
 fn every_code_block_names_its_language() {
-    let root = root();
-    let mut files = vec![root.join("README.md")];
-    files.extend(
-        std::fs::read_dir(root.join("docs"))
-            .unwrap()
-            .map(|e| e.unwrap().path())
-            .filter(|p| p.extension().is_some_and(|e| e == "md")),
-    );
+    let files = doc_files();
     let mut bad = Vec::new();
     for f in &files {
         let text = std::fs::read_to_string(f).unwrap();

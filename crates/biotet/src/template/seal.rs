@@ -440,16 +440,29 @@ fn prism_voxels(t: &Template, q: [[f64; 3]; 3], h: [f64; 3], n: [f64; 3], out: &
             hi[a] = hi[a].max(c[a] + e);
         }
     }
-    // Barycentric coordinates in the plane: solve with the 2×2 Gram system of the two edges.
+    let Some(parts) = prism_parts(q, h, n) else {
+        return;
+    };
+    box_voxels_clipped(t, lo, hi, &parts, None, |x| inside_prism(parts(x)), out);
+}
+
+/// The prism's five affine parts at `x` (see [`box_voxels_clipped`]): its barycentric coordinates
+/// in the mid-plane (solved with the 2×2 Gram system of two edges) and the half-height there
+/// less and plus the signed distance to the plane; `None` for a degenerate triangle.
+fn prism_parts(
+    q: [[f64; 3]; 3],
+    h: [f64; 3],
+    n: [f64; 3],
+) -> Option<impl Fn([f64; 3]) -> [f64; 5]> {
     let e1 = sub(q[1], q[0]);
     let e2 = sub(q[2], q[0]);
     let (a11, a12, a22) = (dot(e1, e1), dot(e1, e2), dot(e2, e2));
     let det = a11 * a22 - a12 * a12;
     if det <= 0.0 || !det.is_finite() {
-        return;
+        return None;
     }
     let inv_det = 1.0 / det;
-    let parts = |x: [f64; 3]| {
+    Some(move |x: [f64; 3]| {
         let r = sub(x, q[0]);
         let dist = dot(r, n);
         let (b1, b2) = (dot(r, e1), dot(r, e2));
@@ -458,24 +471,14 @@ fn prism_voxels(t: &Template, q: [[f64; 3]; 3], h: [f64; 3], n: [f64; 3], out: &
         let l0 = 1.0 - l1 - l2;
         let rhs = l0 * h[0] + l1 * h[1] + l2 * h[2];
         [l0, l1, l2, rhs - dist, rhs + dist]
-    };
-    box_voxels_clipped(
-        t,
-        lo,
-        hi,
-        parts,
-        None,
-        |x| {
-            let r = sub(x, q[0]);
-            let dist = dot(r, n);
-            let (b1, b2) = (dot(r, e1), dot(r, e2));
-            let l1 = (a22 * b1 - a12 * b2) * inv_det;
-            let l2 = (a11 * b2 - a12 * b1) * inv_det;
-            let l0 = 1.0 - l1 - l2;
-            l0 >= 0.0 && l1 >= 0.0 && l2 >= 0.0 && dist.abs() < l0 * h[0] + l1 * h[1] + l2 * h[2]
-        },
-        out,
-    );
+    })
+}
+
+/// Whether [`prism_parts`] place a point strictly inside the prism: barycentric coordinates
+/// non-negative and |distance| below the half-height (`rhs - dist > 0` is `dist < rhs` exactly
+/// in floating point).
+fn inside_prism(p: [f64; 5]) -> bool {
+    p[0] >= 0.0 && p[1] >= 0.0 && p[2] >= 0.0 && p[3] > 0.0 && p[4] > 0.0
 }
 
 #[cfg(test)]
@@ -489,6 +492,13 @@ mod tests {
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
         z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
         ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// The voxels of the box [-2, 3]³ (the whole test grid) that pass `keep`, unclipped.
+    fn whole_box(t: &Template, keep: impl Fn([f64; 3]) -> bool) -> Vec<usize> {
+        let mut out = Vec::new();
+        box_voxels_clipped(t, [-2.0; 3], [3.0; 3], |_| [0.0; 0], None, keep, &mut out);
+        out
     }
 
     /// Row clipping only skips voxels `keep` refuses: on long thin prisms, balls and caps turned
@@ -510,48 +520,16 @@ mod tests {
             let n = scale(n, 1.0 / len);
             let mut clipped = Vec::new();
             prism_voxels(&t, q, [0.05, 0.02, 0.1], n, &mut clipped);
-            // The same prism through the whole box: the parts never clip (all zero).
-            let e1 = sub(q[1], q[0]);
-            let e2 = sub(q[2], q[0]);
-            let (a11, a12, a22) = (dot(e1, e1), dot(e1, e2), dot(e2, e2));
-            let inv_det = 1.0 / (a11 * a22 - a12 * a12);
-            let mut whole = Vec::new();
-            box_voxels_clipped(
-                &t,
-                [-2.0; 3],
-                [3.0; 3],
-                |_| [0.0; 0],
-                None,
-                |x| {
-                    let r = sub(x, q[0]);
-                    let dist = dot(r, n);
-                    let (b1, b2) = (dot(r, e1), dot(r, e2));
-                    let l1 = (a22 * b1 - a12 * b2) * inv_det;
-                    let l2 = (a11 * b2 - a12 * b1) * inv_det;
-                    let l0 = 1.0 - l1 - l2;
-                    l0 >= 0.0
-                        && l1 >= 0.0
-                        && l2 >= 0.0
-                        && dist.abs() < l0 * 0.05 + l1 * 0.02 + l2 * 0.1
-                },
-                &mut whole,
-            );
+            // The same prism through the whole box, unclipped.
+            let parts = prism_parts(q, [0.05, 0.02, 0.1], n).unwrap();
+            let whole = whole_box(&t, |x| inside_prism(parts(x)));
             assert_eq!(clipped, whole, "prism {q:?}");
             nonempty += !whole.is_empty() as usize;
             // A ball and a cap through the same corners.
             let (c, r) = (q[0], norm(sub(q[1], q[0])).min(1.0));
             let mut clipped = Vec::new();
             ball_voxels(&t, c, r, &mut clipped);
-            let mut whole = Vec::new();
-            box_voxels_clipped(
-                &t,
-                [-2.0; 3],
-                [3.0; 3],
-                |_| [0.0; 0],
-                None,
-                |x| dot(sub(x, c), sub(x, c)) < r * r,
-                &mut whole,
-            );
+            let whole = whole_box(&t, |x| dot(sub(x, c), sub(x, c)) < r * r);
             assert_eq!(clipped, whole, "ball {c:?} {r}");
             let h = 0.1 * r;
             let d = (r * r - h * h) / (2.0 * h);
@@ -559,19 +537,10 @@ mod tests {
             let big2 = (d + h) * (d + h);
             let mut clipped = Vec::new();
             cap_voxels(&t, c, r, h, n, &mut clipped);
-            let mut whole = Vec::new();
-            box_voxels_clipped(
-                &t,
-                [-2.0; 3],
-                [3.0; 3],
-                |_| [0.0; 0],
-                None,
-                |x| {
-                    let e = sub(x, centre);
-                    dot(sub(x, c), n) > 0.0 && dot(e, e) < big2
-                },
-                &mut whole,
-            );
+            let mut whole = whole_box(&t, |x| {
+                let e = sub(x, centre);
+                dot(sub(x, c), n) > 0.0 && dot(e, e) < big2
+            });
             let lo = [0, 1, 2].map(|a| c[a].min(c[a] + h * n[a]) - r);
             let hi = [0, 1, 2].map(|a| c[a].max(c[a] + h * n[a]) + r);
             // The cap's own box is smaller than [-2, 3]³: compare within its voxel span.
