@@ -43,7 +43,8 @@ const NOT_RUN: &[(&str, &str)] = &[
     ),
 ];
 
-/// The lines of the `sh` blocks of `text` (`\` continuations joined), with their line numbers.
+/// The lines of the `sh` blocks of `text`, trimmed, `\` continuations joined and `cargo run
+/// --release -p biotet-cli --` read as `biotet`, with their line numbers.
 fn sh_lines(text: &str) -> Vec<(usize, String)> {
     let mut out: Vec<(usize, String)> = Vec::new();
     let mut in_sh = false;
@@ -68,6 +69,12 @@ fn sh_lines(text: &str) -> Vec<(usize, String)> {
         }
         open = cont;
     }
+    for (_, l) in &mut out {
+        let t = l.trim();
+        *l = t
+            .strip_prefix("cargo run --release -p biotet-cli -- ")
+            .map_or(t.to_string(), |r| format!("biotet {r}"));
+    }
     out
 }
 
@@ -80,31 +87,18 @@ fn not_run(line: &str) -> Option<&'static str> {
         .map(|&(_, why)| why)
 }
 
-/// The `biotet` command lines of the `sh` blocks of `text`, with their line numbers:
-/// comments and redirections cut, `cargo run … --` read as `biotet`.
+/// The `biotet` command lines of the `sh` blocks of `text` ([`sh_lines`]), with their line
+/// numbers: comments and redirections cut.
 fn command_lines(text: &str) -> Vec<(usize, Vec<String>)> {
-    let mut out = Vec::new();
-    let mut in_sh = false;
-    for (i, line) in text.lines().enumerate() {
-        let t = line.trim_start();
-        if t.starts_with("```") {
-            in_sh = !in_sh && t.trim_start_matches('`').trim() == "sh";
-            continue;
-        }
-        if !in_sh {
-            continue;
-        }
-        let t = t
-            .strip_prefix("cargo run --release -p biotet-cli -- ")
-            .map_or(t.to_string(), |r| format!("biotet {r}"));
-        let Some(rest) = t.strip_prefix("biotet ") else {
-            continue;
-        };
-        let rest = rest.split(" #").next().unwrap_or("");
-        let rest = rest.split(" > ").next().unwrap_or("");
-        out.push((i + 1, words(rest)));
-    }
-    out
+    sh_lines(text)
+        .into_iter()
+        .filter_map(|(n, t)| {
+            let rest = t.strip_prefix("biotet ")?;
+            let rest = rest.split(" #").next().unwrap_or("");
+            let rest = rest.split(" > ").next().unwrap_or("");
+            Some((n, words(rest)))
+        })
+        .collect()
 }
 
 /// Split on spaces, keeping double-quoted words whole.
@@ -290,12 +284,8 @@ fn every_documented_shell_line_runs() {
                 used[k] = true;
                 continue;
             }
-            let t = match t.strip_prefix("cargo run --release -p biotet-cli -- ") {
-                Some(rest) => format!("biotet {rest}"),
-                None => t.to_string(),
-            };
             script.push_str(&format!("echo '>> {name}:{n}' >&2\n{t}\n"));
-            lines.push((n, t));
+            lines.push((n, t.to_string()));
         }
         if lines.is_empty() {
             continue;

@@ -31,14 +31,16 @@ pub struct Args {
 
 /// Run `biotet check`; exits 1 when the mesh is invalid.
 pub fn run(a: Args) -> Result<ExitCode> {
-    if super::plane::is_tri_mesh(&a.mesh) {
+    // One look at the file (a VTU is read whole to see its cell types).
+    let kind = biotet_io::mesh_kind(&a.mesh)?;
+    if kind == biotet_io::MeshKind::Triangles2d && !super::plane::is_pslg(&a.mesh) {
         if a.surfaces.len() > 1 {
             anyhow::bail!("a 2D mesh takes at most one --surface: the PSLG");
         }
         return super::plane::check_cmd(&a.mesh, a.surfaces.first().map(|p| p.as_path()), a.common);
     }
     // A file of triangles only would read as a mesh of no tets, "invalid" for no stated reason.
-    if biotet_io::mesh_kind(&a.mesh)? == biotet_io::MeshKind::Surface {
+    if kind == biotet_io::MeshKind::Surface {
         anyhow::bail!(
             "{}: holds triangles and no tets (a surface, or a 2D mesh written as .vtu, which is \
              written only); `biotet check` reads tet meshes, and 2D meshes from .mesh or .node/.ele",

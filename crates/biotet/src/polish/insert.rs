@@ -59,21 +59,8 @@ impl Work {
         // from the tet's edge cavity, a cone with four tets at 9.8°; coned over the whole box,
         // every tet is above 11.9°.
         if self.rescue_flat {
-            let mut wide = faces.clone();
-            for _ in 0..2 {
-                for s in wide.clone() {
-                    for n in self.nb[s as usize] {
-                        if n != NO_NEIGHBOR
-                            && self.labels[n as usize] == label
-                            && !self.is_forced(n)
-                        {
-                            wide.push(n);
-                        }
-                    }
-                }
-                wide.sort_unstable();
-                wide.dedup();
-            }
+            let ring = self.face_ring(&faces, label);
+            let wide = self.face_ring(&ring, label);
             if wide != faces
                 && let Some(ids) = self.insert_into(t, wide, thr, searcher, rp, sp, star)
             {
@@ -108,16 +95,7 @@ impl Work {
         }
         // The face cavity and its face neighbours (past the edge cavity where a wedge's far
         // edge or a sliver's neighbours need a point further out).
-        let mut ring = faces.clone();
-        for &s in &faces {
-            for n in self.nb[s as usize] {
-                if n != NO_NEIGHBOR && self.labels[n as usize] == label && !self.is_forced(n) {
-                    ring.push(n);
-                }
-            }
-        }
-        ring.sort_unstable();
-        ring.dedup();
+        let ring = self.face_ring(&faces, label);
         if ring != faces
             && ring != edges
             && let Some(ids) = self.insert_into(t, ring.clone(), thr, searcher, rp, sp, star)

@@ -132,10 +132,17 @@ impl Work {
     /// Tet `t` and its unforced face neighbours of its label, sorted.
     pub fn with_face_neighbours(&mut self, t: u32) -> Vec<u32> {
         let label = self.labels[t as usize];
-        let mut out = vec![t];
-        for n in self.nb[t as usize] {
-            if n != NO_NEIGHBOR && self.labels[n as usize] == label && !self.is_forced(n) {
-                out.push(n);
+        self.face_ring(&[t], label)
+    }
+
+    /// `tets` and their unforced face neighbours of label `label`, sorted.
+    pub fn face_ring(&mut self, tets: &[u32], label: u32) -> Vec<u32> {
+        let mut out = tets.to_vec();
+        for &s in tets {
+            for n in self.nb[s as usize] {
+                if n != NO_NEIGHBOR && self.labels[n as usize] == label && !self.is_forced(n) {
+                    out.push(n);
+                }
             }
         }
         out.sort_unstable();
