@@ -296,6 +296,10 @@ impl Work {
         let (cav, on_shell) = self.cavity_of_shell_points(tets)?;
         let (x, cone_ok) = self.best_point(t, &cav.tets, &cav.shell, thr)?;
         let old = judge(self, &cav.tets, thr, Judge::MinAngle);
+        // In the last pass, a flat tet (under a thousandth of the threshold: gmsh's t13 kept two
+        // at 3e-15°, a solver's stiffness matrix then singular to round-off) is traded for any
+        // fill whose every tet is above a hundredth of it, however many are then below it.
+        let deep = self.rescue_deep && old.1 < 1e-3 * thr;
         let old_tets: Vec<[u32; 4]> = cav.tets.iter().map(|&s| self.tets[s as usize]).collect();
         let p = self.pts.len() as u32;
         self.pts.push(x);
@@ -328,7 +332,7 @@ impl Work {
             // with no tet above the threshold below it: more than before, and no fill can pass.
             let poor = faces_without_candidate(&self.pts, &cav.shell, &cands, thr);
             for floor in [thr, old.1.max(new.1).max(0.0) * (1.0 + 1e-9)] {
-                if floor < thr && (large || poor.div_ceil(4) > old.2) {
+                if floor < thr && (large || poor.div_ceil(4) > old.2) && !deep {
                     break;
                 }
                 if !every_face_has_candidate(&self.pts, &cav.shell, &cands, floor) {
@@ -350,7 +354,11 @@ impl Work {
         // round-off kept a 0.00° tet whose cone from one point is at 9.8°). Only last: earlier,
         // such a trade can block a later fix that leaves none below the threshold.
         let flat_out = old.1 < 0.1 * thr && new.1 >= 0.5 * thr;
-        if new.0 > old.0 && new.1 >= old.1 && (new.2 <= old.2 || (self.rescue_flat && flat_out)) {
+        let deep_out = deep && new.1 >= 1e-2 * thr;
+        if new.0 > old.0
+            && new.1 >= old.1
+            && (new.2 <= old.2 || (self.rescue_flat && flat_out) || deep_out)
+        {
             return Some(ids);
         }
         if flat_out && new.0 > old.0 && !self.rescue_flat {

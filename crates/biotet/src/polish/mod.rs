@@ -286,9 +286,39 @@ pub fn polish(mesh: &mut TetMesh, opts: &PolishOptions) -> PolishReport {
                 }
             }
             w.rescue_flat = false;
-            if report.flat_rescued > 0 {
-                moves_after_points(&mut w, &mut bad, thr, &params, &mut star, &mut report);
+        }
+        // Then the flat ones (under a thousandth of the threshold), flattest first, each for
+        // any fill above a hundredth of it (`Work::insert`): the worst tet is what a solver
+        // feels, so this stops at the first that stays (past it, each rescue would only add tets
+        // below the threshold without raising the worst).
+        let mut deep: Vec<(f64, u32)> = Vec::new();
+        for t in 0..w.tets.len() as u32 {
+            if w.alive[t as usize] {
+                let a = w.min_angle(t);
+                if a < 1e-3 * thr && !w.is_forced(t) {
+                    deep.push((a, t));
+                }
             }
+        }
+        deep.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        w.rescue_flat = true;
+        w.rescue_deep = true;
+        for (_, t) in deep {
+            if !w.alive[t as usize] || w.min_angle(t) >= 1e-3 * thr {
+                continue;
+            }
+            if w.insert(t, thr, &mut searcher, &rp, &params, &mut star)
+                .is_none()
+            {
+                break;
+            }
+            report.inserts_accepted += 1;
+            report.flat_rescued += 1;
+        }
+        w.rescue_flat = false;
+        w.rescue_deep = false;
+        if report.flat_rescued > 0 {
+            moves_after_points(&mut w, &mut bad, thr, &params, &mut star, &mut report);
         }
         report.ms[4] = c.elapsed().as_secs_f64() * 1e3;
     }

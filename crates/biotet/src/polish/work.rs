@@ -32,6 +32,9 @@ pub(super) struct Work {
     /// Set for polish's last pass only: an insertion may trade a nearly flat tet for a few just
     /// below the threshold ([`Work::insert`]).
     pub rescue_flat: bool,
+    /// Set while the flattest tets are rescued (after `rescue_flat`'s): an insertion may trade
+    /// a tet under a thousandth of the threshold for any fill above a hundredth of it.
+    pub rescue_deep: bool,
     /// Tets whose insertion was refused only for that count (the last pass retries these alone).
     pub rescuable: Vec<u32>,
 }
@@ -52,6 +55,7 @@ impl Work {
             free: Vec::new(),
             forced_deg,
             rescue_flat: false,
+            rescue_deep: false,
             rescuable: Vec::new(),
         };
         for t in 0..n {
