@@ -125,7 +125,8 @@ pub struct PolishReport {
     /// Of those, points in front of a wedge's short edge.
     pub wedges_accepted: usize,
     /// Nearly flat unforced tets (under a tenth of the threshold) replaced in the last pass by a
-    /// point's tets, all at least half the threshold (possibly more of them below it).
+    /// point's tets, all at least half the threshold (possibly more of them below it); and flat
+    /// ones (under a thousandth of it) by tets all above a hundredth of it.
     pub flat_rescued: usize,
     /// Points added (inserted and still there at the end).
     pub points_added: usize,
