@@ -268,6 +268,9 @@ pub fn polish(mesh: &mut TetMesh, opts: &PolishOptions) -> PolishReport {
                 break;
             }
         }
+        // The flat ones, from the scan after the rounds, flattest first (`bad` is sorted; the
+        // pass below adds no tet under half the threshold).
+        let deep: Vec<(f64, u32)> = bad.iter().copied().filter(|x| x.0 < 1e-3 * thr).collect();
         // Last, the nearly flat tets still there: a point whose tets are all at least half the
         // threshold replaces one even with more of them below the threshold.
         // Only those refused before for the count alone: the others would fail again.
@@ -292,16 +295,6 @@ pub fn polish(mesh: &mut TetMesh, opts: &PolishOptions) -> PolishReport {
         // any fill above a hundredth of it (`Work::insert`): the worst tet is what a solver
         // feels, so this stops at the first that stays (past it, each rescue would only add tets
         // below the threshold without raising the worst).
-        let mut deep: Vec<(f64, u32)> = Vec::new();
-        for t in 0..w.tets.len() as u32 {
-            if w.alive[t as usize] {
-                let a = w.min_angle(t);
-                if a < 1e-3 * thr && !w.is_forced(t) {
-                    deep.push((a, t));
-                }
-            }
-        }
-        deep.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         w.rescue_flat = true;
         w.rescue_deep = true;
         for (_, t) in deep {
