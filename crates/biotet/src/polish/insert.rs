@@ -37,7 +37,7 @@ use super::refill::{
     Judge, RefillParams, every_face_has_candidate, faces_without_candidate, judge,
 };
 use super::relocate::StepParams;
-use super::work::{Cavity, P3, Work};
+use super::work::{Cavity, DEEP_FLAT, DEEP_FLOOR, P3, Rescue, Work};
 
 impl Work {
     /// Try to raise `t` (unforced, below `thr` degrees) with one new interior point; the new
@@ -58,7 +58,7 @@ impl Work {
         // threshold. A randomly turned box whose only fill of its corners has a flat tet got,
         // from the tet's edge cavity, a cone with four tets at 9.8°; coned over the whole box,
         // every tet is above 11.9°.
-        if self.rescue_flat {
+        if self.rescue >= Rescue::Flat {
             let ring = self.face_ring(&faces, label);
             let wide = self.face_ring(&ring, label);
             if wide != faces
@@ -299,7 +299,7 @@ impl Work {
         // In the last pass, a flat tet (under a thousandth of the threshold: gmsh's t13 kept two
         // at 3e-15°, a solver's stiffness matrix then singular to round-off) is traded for any
         // fill whose every tet is above a hundredth of it, however many are then below it.
-        let deep = self.rescue_deep && old.1 < 1e-3 * thr;
+        let deep = self.rescue == Rescue::Deep && old.1 < DEEP_FLAT * thr;
         let old_tets: Vec<[u32; 4]> = cav.tets.iter().map(|&s| self.tets[s as usize]).collect();
         let p = self.pts.len() as u32;
         self.pts.push(x);
@@ -354,14 +354,12 @@ impl Work {
         // round-off kept a 0.00° tet whose cone from one point is at 9.8°). Only last: earlier,
         // such a trade can block a later fix that leaves none below the threshold.
         let flat_out = old.1 < 0.1 * thr && new.1 >= 0.5 * thr;
-        let deep_out = deep && new.1 >= 1e-2 * thr;
-        if new.0 > old.0
-            && new.1 >= old.1
-            && (new.2 <= old.2 || (self.rescue_flat && flat_out) || deep_out)
-        {
+        let deep_out = deep && new.1 >= DEEP_FLOOR * thr;
+        let last = self.rescue >= Rescue::Flat;
+        if new.0 > old.0 && new.1 >= old.1 && (new.2 <= old.2 || (last && flat_out) || deep_out) {
             return Some(ids);
         }
-        if flat_out && new.0 > old.0 && !self.rescue_flat {
+        if flat_out && new.0 > old.0 && !last {
             self.rescuable.push(t);
         }
         if filled {

@@ -43,7 +43,7 @@ use crate::mesh::tet::{NO_NEIGHBOR, TetMesh};
 use crate::quality::tet::min_dihedral_chord2;
 use refill::{Judge, RefillParams};
 use relocate::StepParams;
-use work::Work;
+use work::{DEEP_FLAT, Rescue, Work};
 
 /// Options of [`polish`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -270,7 +270,11 @@ pub fn polish(mesh: &mut TetMesh, opts: &PolishOptions) -> PolishReport {
         }
         // The flat ones, from the scan after the rounds, flattest first (`bad` is sorted; the
         // pass below adds no tet under half the threshold).
-        let deep: Vec<(f64, u32)> = bad.iter().copied().filter(|x| x.0 < 1e-3 * thr).collect();
+        let deep: Vec<(f64, u32)> = bad
+            .iter()
+            .copied()
+            .filter(|x| x.0 < DEEP_FLAT * thr)
+            .collect();
         // Last, the nearly flat tets still there: a point whose tets are all at least half the
         // threshold replaces one even with more of them below the threshold.
         // Only those refused before for the count alone: the others would fail again.
@@ -278,7 +282,7 @@ pub fn polish(mesh: &mut TetMesh, opts: &PolishOptions) -> PolishReport {
         flat.sort_unstable();
         flat.dedup();
         if !flat.is_empty() {
-            w.rescue_flat = true;
+            w.rescue = Rescue::Flat;
             for t in flat {
                 if w.alive[t as usize]
                     && w.min_angle(t) < 0.1 * thr
@@ -289,16 +293,15 @@ pub fn polish(mesh: &mut TetMesh, opts: &PolishOptions) -> PolishReport {
                     report.flat_rescued += 1;
                 }
             }
-            w.rescue_flat = false;
+            w.rescue = Rescue::Off;
         }
         // Then the flat ones (under a thousandth of the threshold), flattest first, each for
         // any fill above a hundredth of it (`Work::insert`): the worst tet is what a solver
         // feels, so this stops at the first that stays (past it, each rescue would only add tets
         // below the threshold without raising the worst).
-        w.rescue_flat = true;
-        w.rescue_deep = true;
+        w.rescue = Rescue::Deep;
         for (_, t) in deep {
-            if !w.alive[t as usize] || w.min_angle(t) >= 1e-3 * thr {
+            if !w.alive[t as usize] || w.min_angle(t) >= DEEP_FLAT * thr {
                 continue;
             }
             if w.insert(t, thr, &mut searcher, &rp, &params, &mut star)
@@ -309,8 +312,7 @@ pub fn polish(mesh: &mut TetMesh, opts: &PolishOptions) -> PolishReport {
             report.inserts_accepted += 1;
             report.flat_rescued += 1;
         }
-        w.rescue_flat = false;
-        w.rescue_deep = false;
+        w.rescue = Rescue::Off;
         if report.flat_rescued > 0 {
             moves_after_points(&mut w, &mut bad, thr, &params, &mut star, &mut report);
         }

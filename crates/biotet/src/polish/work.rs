@@ -29,15 +29,30 @@ pub(super) struct Work {
     forced: Vec<u8>,
     free: Vec<u32>,
     forced_deg: f64,
-    /// Set for polish's last pass only: an insertion may trade a nearly flat tet for a few just
-    /// below the threshold ([`Work::insert`]).
-    pub rescue_flat: bool,
-    /// Set while the flattest tets are rescued (after `rescue_flat`'s): an insertion may trade
-    /// a tet under a thousandth of the threshold for any fill above a hundredth of it.
-    pub rescue_deep: bool,
+    /// Which of polish's last passes runs ([`Work::insert`] accepts more in them).
+    pub rescue: Rescue,
     /// Tets whose insertion was refused only for that count (the last pass retries these alone).
     pub rescuable: Vec<u32>,
 }
+
+/// Polish's last passes, each accepting more than the one before (ordered).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Rescue {
+    /// The rounds: an insertion may not add tets below the threshold.
+    Off,
+    /// A nearly flat tet (under a tenth of the threshold) may go for a few just below it, every
+    /// new tet at least half of it.
+    Flat,
+    /// Also a flat one (under [`DEEP_FLAT`] of the threshold), for any fill above
+    /// [`DEEP_FLOOR`] of it.
+    Deep,
+}
+
+/// Tets under this fraction of the threshold are flat: [`Rescue::Deep`] takes them.
+pub const DEEP_FLAT: f64 = 1e-3;
+
+/// [`Rescue::Deep`] accepts a fill whose every tet is above this fraction of the threshold.
+pub const DEEP_FLOOR: f64 = 1e-2;
 
 impl Work {
     pub fn new(mesh: &mut TetMesh, forced_deg: f64) -> Work {
@@ -54,8 +69,7 @@ impl Work {
             forced: vec![0; n],
             free: Vec::new(),
             forced_deg,
-            rescue_flat: false,
-            rescue_deep: false,
+            rescue: Rescue::Off,
             rescuable: Vec::new(),
         };
         for t in 0..n {

@@ -137,6 +137,16 @@ pub fn load_stl(name: &str) -> SurfaceMesh {
     s
 }
 
+/// The sizing `biotet mesh` uses by default: from the surface, graded 0.3 (its `--grading`).
+pub fn default_sizing(s: &SurfaceMesh) -> biotet::sizing::Sizing {
+    use biotet::sizing::{SizeSpec, Sizing, SizingOptions};
+    Sizing::new(
+        s,
+        SizingOptions::new(SizeSpec::FromSurface { grading: 0.3 }),
+    )
+    .unwrap()
+}
+
 /// A surface of the shape corpus (`tests/data/shapes`), as one closed region.
 pub fn load_shape(name: &str) -> SurfaceMesh {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../tests/data/shapes/");

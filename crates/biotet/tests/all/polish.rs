@@ -317,14 +317,9 @@ fn polish_rescues_a_flat_tet_of_a_thin_box_with_every_tet_above_the_threshold() 
 fn polish_rescues_the_flattest_tet_of_a_cad_stl() {
     use biotet::mesh::validate::{ValidateOptions, validate_surface};
     use biotet::pipeline::{PipelineOptions, mesh_surface};
-    use biotet::sizing::{SizeSpec, Sizing, SizingOptions};
     let mut s = crate::common::load_shape("pkg_gmsh_t13.off");
     validate_surface(&mut s, &ValidateOptions::default()).unwrap();
-    let sizing = Sizing::new(
-        &s,
-        SizingOptions::new(SizeSpec::FromSurface { grading: 0.3 }),
-    )
-    .unwrap();
+    let sizing = crate::common::default_sizing(&s);
     let (m, report) = mesh_surface(&s, &sizing, &PipelineOptions::default(), &mut |_| {}).unwrap();
     let p = report.polish.as_ref().unwrap();
     assert!(p.flat_rescued >= 1, "{p:?}");

@@ -6,7 +6,7 @@ use biotet::mesh::shells::{AssembleError, Part, assemble, touching};
 use biotet::mesh::validate::{ValidateOptions, validate_surface};
 use biotet::pipeline::{PipelineOptions, mesh_surface};
 use biotet::quality::tet::volume;
-use biotet::sizing::{SizeSpec, Sizing, SizingOptions};
+use biotet::sizing::Sizing;
 
 fn part(s: SurfaceMesh, labels: Option<Vec<u32>>) -> Part {
     Part { surface: s, labels }
@@ -81,11 +81,7 @@ fn nested_brain_and_white_matter_mesh_into_two_regions() {
     assert_eq!(shells.len(), 2);
     assert_eq!(shells[1].parent, Some(0));
     validate_surface(&mut s, &ValidateOptions::default()).unwrap();
-    let sizing = Sizing::new(
-        &s,
-        SizingOptions::new(SizeSpec::FromSurface { grading: 0.3 }),
-    )
-    .unwrap();
+    let sizing = crate::common::default_sizing(&s);
     let (mesh, _) =
         mesh_surface(&s, &sizing, &PipelineOptions::deploy_only(), &mut |_| {}).unwrap();
     let vol = region_volumes(&mesh);

@@ -65,11 +65,7 @@ fn a_thin_tube_gets_interior_nodes_and_no_flat_tets() {
     let mut s = SurfaceMesh::closed(points, triangles, 1);
     let v = biotet::mesh::validate::validate_surface(&mut s, &Default::default());
     assert!(!v.expect("a valid torus").flipped_inward);
-    let sizing = Sizing::new(
-        &s,
-        SizingOptions::new(SizeSpec::FromSurface { grading: 0.3 }),
-    )
-    .unwrap();
+    let sizing = crate::common::default_sizing(&s);
     // At a node: at most half the tube's width (the wall facing it is a diameter away).
     assert!(sizing.at(s.points[0], 1) <= minor * 1.001);
     let (m, report) = mesh_surface(&s, &sizing, &PipelineOptions::default(), &mut |_| {}).unwrap();

@@ -234,11 +234,7 @@ fn deployment_is_deterministic_and_template_is_one_byte_per_voxel() {
 #[test]
 fn pipeline_on_the_brain_keeps_the_inside() {
     let s = load_stl("brain_20k.stl");
-    let sizing = biotet::sizing::Sizing::new(
-        &s,
-        biotet::sizing::SizingOptions::new(biotet::sizing::SizeSpec::FromSurface { grading: 0.3 }),
-    )
-    .unwrap();
+    let sizing = crate::common::default_sizing(&s);
     let (mesh, report) =
         mesh_surface(&s, &sizing, &PipelineOptions::deploy_only(), &mut |_| {}).unwrap();
     let c = check(&mesh, None);
