@@ -59,6 +59,7 @@ const PIECE: usize = 128;
 /// sealing only turns unprocessed voxels into buffer, so the order does not matter and the
 /// result is the same on any number of threads.
 pub fn seal_triangles(t: &mut Template, surface: &SurfaceMesh, size: &[f64]) -> usize {
+    t.index_inside_rows();
     let mut sealed = 0;
     // Built on first use: most surfaces have no triangle that needs a cap.
     let points = std::sync::OnceLock::new();
@@ -195,7 +196,10 @@ fn circumsphere(p: [[f64; 3]; 3]) -> Option<([f64; 3], f64)> {
 /// Conservative: the range is widened by two voxels past each root, a part nearly constant along
 /// the row (its root not known to within a voxel) does not clip, and a row leaves the sphere only
 /// by a margin far above round-off; `keep` decides every voxel in the range, so the voxels found
-/// are those of the whole box's scan, in the same order.
+/// are those of the whole box's scan, in the same order. Once [`Template::index_inside_rows`]
+/// has run, each row is also clipped to its inside span (only inside voxels become nodes): a
+/// turned capsule's balls and prisms reach far outside it (its buffer 0.16 s → 0.05 s, the
+/// nodes the same).
 fn box_voxels_clipped<const M: usize>(
     t: &Template,
     lo: [f64; 3],
@@ -220,6 +224,14 @@ fn box_voxels_clipped<const M: usize>(
     for k in k0..=k1 {
         for j in j0..=j1 {
             let row = t.index(0, j, k);
+            // Only inside voxels become nodes: the rest of the row need not be marked.
+            let inside = t
+                .inside_rows
+                .get(j + t.n[1] * k)
+                .map_or([0, u32::MAX], |r| *r);
+            if inside[0] > inside[1] || (inside[1] as usize) < i0 || inside[0] as usize > i1 {
+                continue;
+            }
             let (mut a, mut b) = if M == 0 || !clip {
                 (i0, i1)
             } else {
@@ -245,6 +257,7 @@ fn box_voxels_clipped<const M: usize>(
                 a = a.max(from.max(0.0) as usize);
                 b = b.min(to as usize);
             }
+            let (a, b) = (a.max(inside[0] as usize), b.min(inside[1] as usize));
             for i in a..=b.min(i1) {
                 let idx = row + i;
                 if t.state(idx) == UNPROCESSED && keep(t.point([i, j, k])) {
@@ -494,11 +507,16 @@ mod tests {
         ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
     }
 
-    /// The voxels of the box [-2, 3]³ (the whole test grid) that pass `keep`, unclipped.
+    /// The voxels of the whole test grid that pass `keep` (and are inside, once the template's
+    /// inside rows are indexed), scanned one by one in index order.
     fn whole_box(t: &Template, keep: impl Fn([f64; 3]) -> bool) -> Vec<usize> {
-        let mut out = Vec::new();
-        box_voxels_clipped(t, [-2.0; 3], [3.0; 3], |_| [0.0; 0], None, keep, &mut out);
-        out
+        (0..t.cells.len())
+            .filter(|&idx| {
+                (t.inside_rows.is_empty() || t.region(idx) != 0)
+                    && t.state(idx) == UNPROCESSED
+                    && keep(t.point(t.ijk(idx)))
+            })
+            .collect()
     }
 
     /// Row clipping only skips voxels `keep` refuses: on long thin prisms, balls and caps turned
@@ -506,7 +524,38 @@ mod tests {
     /// in the same order.
     #[test]
     fn clipped_scans_find_the_voxels_of_the_whole_box() {
-        let t = Template::new([96, 80, 72], [-1.0, -0.5, -0.75], 1.0 / 32.0);
+        clipped_scans_match(Template::new([96, 80, 72], [-1.0, -0.5, -0.75], 1.0 / 32.0));
+    }
+
+    /// With the inside rows indexed, the scans find exactly the inside voxels of a whole-box
+    /// scan: here the inside is a ball that most of the shapes cross, and rows miss it whole.
+    #[test]
+    fn clipped_scans_keep_to_the_inside_rows() {
+        let mut t = Template::new([96, 80, 72], [-1.0, -0.5, -0.75], 1.0 / 32.0);
+        let (c, r) = ([0.4, 0.6, 0.5], 0.7);
+        for k in 0..t.n[2] {
+            for j in 0..t.n[1] {
+                let row = t.index(0, j, k);
+                let y = t.point([0, j, k]);
+                let d = r * r - (y[1] - c[1]).powi(2) - (y[2] - c[2]).powi(2);
+                if d <= 0.0 {
+                    continue;
+                }
+                let inside = |i: usize| (t.coord(0, i) - c[0]).abs() < d.sqrt();
+                let lo = (0..t.n[0]).find(|&i| inside(i));
+                let hi = (0..t.n[0]).rev().find(|&i| inside(i));
+                if let (Some(lo), Some(hi)) = (lo, hi) {
+                    t.set_region_span(row, lo, hi + 1, 1);
+                }
+            }
+        }
+        t.index_inside_rows();
+        assert!(t.inside_rows.iter().any(|r| r[0] > r[1]));
+        assert!(t.inside_rows.iter().any(|r| r[0] <= r[1]));
+        clipped_scans_match(t);
+    }
+
+    fn clipped_scans_match(t: Template) {
         let mut s = 7u64;
         let mut p = || [0, 1, 2].map(|_| rand(&mut s) * 2.0 - 0.5);
         let mut nonempty = 0;

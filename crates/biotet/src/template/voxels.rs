@@ -39,6 +39,9 @@ pub struct Template {
     pub dx: f64,
     /// One byte per voxel, x fastest.
     pub cells: Vec<u8>,
+    /// Per row `(j, k)` (index `j + n[1]·k`), its first and last inside voxel (`[1, 0]`: none);
+    /// empty until [`Template::index_inside_rows`].
+    pub inside_rows: Vec<[u32; 2]>,
 }
 
 impl Template {
@@ -49,7 +52,25 @@ impl Template {
             origin,
             dx,
             cells: vec![0; n[0] * n[1] * n[2]],
+            inside_rows: Vec::new(),
         }
+    }
+
+    /// Fill [`Template::inside_rows`] from the regions (after classification): the sealing
+    /// scans only the inside part of each row, since only inside voxels become nodes.
+    pub fn index_inside_rows(&mut self) {
+        let nx = self.n[0];
+        self.inside_rows = self
+            .cells
+            .chunks_exact(nx)
+            .map(|row| {
+                let inside = |c: &u8| c >> REGION_SHIFT != 0;
+                match (row.iter().position(inside), row.iter().rposition(inside)) {
+                    (Some(f), Some(l)) => [f as u32, l as u32],
+                    _ => [1, 0],
+                }
+            })
+            .collect();
     }
 
     /// Linear index of voxel `(i, j, k)`.
