@@ -59,7 +59,6 @@ const PIECE: usize = 128;
 /// sealing only turns unprocessed voxels into buffer, so the order does not matter and the
 /// result is the same on any number of threads.
 pub fn seal_triangles(t: &mut Template, surface: &SurfaceMesh, size: &[f64]) -> usize {
-    t.index_inside_rows();
     let mut sealed = 0;
     // Built on first use: most surfaces have no triangle that needs a cap.
     let points = std::sync::OnceLock::new();
@@ -196,10 +195,9 @@ fn circumsphere(p: [[f64; 3]; 3]) -> Option<([f64; 3], f64)> {
 /// Conservative: the range is widened by two voxels past each root, a part nearly constant along
 /// the row (its root not known to within a voxel) does not clip, and a row leaves the sphere only
 /// by a margin far above round-off; `keep` decides every voxel in the range, so the voxels found
-/// are those of the whole box's scan, in the same order. Once [`Template::index_inside_rows`]
-/// has run, each row is also clipped to its inside span (only inside voxels become nodes): a
-/// turned capsule's balls and prisms reach far outside it (its buffer 0.16 s → 0.05 s, the
-/// nodes the same).
+/// are those of the whole box's scan, in the same order. Each row is also clipped to its inside
+/// span ([`Template::inside_rows`]; only inside voxels become nodes): a turned capsule's balls
+/// and prisms reach far outside it (its buffer 0.16 s → 0.05 s, the nodes the same).
 fn box_voxels_clipped<const M: usize>(
     t: &Template,
     lo: [f64; 3],
@@ -225,10 +223,7 @@ fn box_voxels_clipped<const M: usize>(
         for j in j0..=j1 {
             let row = t.index(0, j, k);
             // Only inside voxels become nodes: the rest of the row need not be marked.
-            let inside = t
-                .inside_rows
-                .get(j + t.n[1] * k)
-                .map_or([0, u32::MAX], |r| *r);
+            let inside = t.inside_rows[j + t.n[1] * k];
             if inside[0] > inside[1] || (inside[1] as usize) < i0 || inside[0] as usize > i1 {
                 continue;
             }
@@ -507,14 +502,12 @@ mod tests {
         ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
     }
 
-    /// The voxels of the whole test grid that pass `keep` (and are inside, once the template's
-    /// inside rows are indexed), scanned one by one in index order.
+    /// The inside voxels of the whole test grid that pass `keep`, scanned one by one in index
+    /// order.
     fn whole_box(t: &Template, keep: impl Fn([f64; 3]) -> bool) -> Vec<usize> {
         (0..t.cells.len())
             .filter(|&idx| {
-                (t.inside_rows.is_empty() || t.region(idx) != 0)
-                    && t.state(idx) == UNPROCESSED
-                    && keep(t.point(t.ijk(idx)))
+                t.region(idx) != 0 && t.state(idx) == UNPROCESSED && keep(t.point(t.ijk(idx)))
             })
             .collect()
     }
@@ -524,11 +517,16 @@ mod tests {
     /// in the same order.
     #[test]
     fn clipped_scans_find_the_voxels_of_the_whole_box() {
-        clipped_scans_match(Template::new([96, 80, 72], [-1.0, -0.5, -0.75], 1.0 / 32.0));
+        let mut t = Template::new([96, 80, 72], [-1.0, -0.5, -0.75], 1.0 / 32.0);
+        // Everything inside: the shapes' own clipping alone.
+        for row in (0..t.cells.len()).step_by(t.n[0]) {
+            t.set_region_span(row, 0, t.n[0], 1);
+        }
+        clipped_scans_match(t);
     }
 
-    /// With the inside rows indexed, the scans find exactly the inside voxels of a whole-box
-    /// scan: here the inside is a ball that most of the shapes cross, and rows miss it whole.
+    /// The scans find exactly the inside voxels of a whole-box scan: here the inside is a ball
+    /// that most of the shapes cross, and rows miss it whole.
     #[test]
     fn clipped_scans_keep_to_the_inside_rows() {
         let mut t = Template::new([96, 80, 72], [-1.0, -0.5, -0.75], 1.0 / 32.0);
@@ -549,7 +547,6 @@ mod tests {
                 }
             }
         }
-        t.index_inside_rows();
         assert!(t.inside_rows.iter().any(|r| r[0] > r[1]));
         assert!(t.inside_rows.iter().any(|r| r[0] <= r[1]));
         clipped_scans_match(t);

@@ -39,8 +39,9 @@ pub struct Template {
     pub dx: f64,
     /// One byte per voxel, x fastest.
     pub cells: Vec<u8>,
-    /// Per row `(j, k)` (index `j + n[1]·k`), its first and last inside voxel (`[1, 0]`: none);
-    /// empty until [`Template::index_inside_rows`].
+    /// Per row `(j, k)` (index `j + n[1]·k`), its first and last inside voxel (first above last:
+    /// none), kept by [`Template::set_region_span`]: sealing scans only that part of a row, since
+    /// only inside voxels become nodes.
     pub inside_rows: Vec<[u32; 2]>,
 }
 
@@ -52,25 +53,8 @@ impl Template {
             origin,
             dx,
             cells: vec![0; n[0] * n[1] * n[2]],
-            inside_rows: Vec::new(),
+            inside_rows: vec![[u32::MAX, 0]; n[1] * n[2]],
         }
-    }
-
-    /// Fill [`Template::inside_rows`] from the regions (after classification): the sealing
-    /// scans only the inside part of each row, since only inside voxels become nodes.
-    pub fn index_inside_rows(&mut self) {
-        let nx = self.n[0];
-        self.inside_rows = self
-            .cells
-            .chunks_exact(nx)
-            .map(|row| {
-                let inside = |c: &u8| c >> REGION_SHIFT != 0;
-                match (row.iter().position(inside), row.iter().rposition(inside)) {
-                    (Some(f), Some(l)) => [f as u32, l as u32],
-                    _ => [1, 0],
-                }
-            })
-            .collect();
     }
 
     /// Linear index of voxel `(i, j, k)`.
@@ -138,6 +122,11 @@ impl Template {
         let bits = (region as u8) << REGION_SHIFT;
         for c in &mut self.cells[row_start + lo..row_start + hi] {
             *c |= bits;
+        }
+        if region != 0 && lo < hi {
+            let r = &mut self.inside_rows[row_start / self.n[0]];
+            r[0] = r[0].min(lo as u32);
+            r[1] = r[1].max((hi - 1) as u32);
         }
     }
 
