@@ -141,12 +141,30 @@ pub struct MeshEstimate {
     pub bytes: f64,
 }
 
-/// Estimate the memory of meshing `surface` (see [`MeshEstimate`]).
-pub fn estimate_mesh(
+/// The estimate of meshing `surface` (see [`MeshEstimate`]) when it exceeds `limit` bytes, else
+/// `None`. The sizes are sampled only when the bound with the smallest size everywhere exceeds
+/// the limit (on a small surface the samples would cost more than the meshing).
+pub fn over_limit(
     surface: &biotet::SurfaceMesh,
     sizing: &biotet::sizing::Sizing,
     deploy: &biotet::template::DeployOptions,
-) -> MeshEstimate {
+    limit: f64,
+) -> Option<MeshEstimate> {
+    let (volume, lo, ext, voxels) = extent(surface, sizing, deploy);
+    let most = nodes_bytes(voxels, 0.86 * volume / sizing.min_size().powi(3));
+    if most <= limit {
+        return None;
+    }
+    let e = sampled(sizing, volume, lo, ext, voxels);
+    (e.bytes > limit).then_some(e)
+}
+
+/// The inside volume (absolute), the bounding box's corner and extent, and the template voxels.
+fn extent(
+    surface: &biotet::SurfaceMesh,
+    sizing: &biotet::sizing::Sizing,
+    deploy: &biotet::template::DeployOptions,
+) -> (f64, [f64; 3], [f64; 3], f64) {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     // The inside volume: triangles with the outside on one side only (interfaces add nothing).
@@ -172,6 +190,23 @@ pub fn estimate_mesh(
     let dx = sizing.min_size() / deploy.resolution;
     let m = 2.0 * deploy.margin as f64 + 2.0;
     let voxels = ext.iter().map(|e| e / dx + m).product::<f64>();
+    (volume.abs(), lo, ext, voxels)
+}
+
+/// Peak bytes of `voxels` template voxels and `nodes` nodes.
+fn nodes_bytes(voxels: f64, nodes: f64) -> f64 {
+    let bytes = voxels * BYTES_PER_VOXEL + nodes * TETS_PER_NODE * BYTES_PER_TET;
+    if bytes.is_nan() { f64::INFINITY } else { bytes }
+}
+
+/// The estimate with the sizes sampled on a 32³ grid over the bounding box.
+fn sampled(
+    sizing: &biotet::sizing::Sizing,
+    volume: f64,
+    lo: [f64; 3],
+    ext: [f64; 3],
+    voxels: f64,
+) -> MeshEstimate {
     const N: usize = 32;
     let cell = ext.map(|e| e / N as f64);
     let mut per_volume = 0.0;
@@ -187,12 +222,11 @@ pub fn estimate_mesh(
             }
         }
     }
-    let nodes = 0.86 * volume.abs() * per_volume / (N * N * N) as f64;
-    let bytes = voxels * BYTES_PER_VOXEL + nodes * TETS_PER_NODE * BYTES_PER_TET;
+    let nodes = 0.86 * volume * per_volume / (N * N * N) as f64;
     MeshEstimate {
         voxels,
         nodes,
-        bytes: if bytes.is_nan() { f64::INFINITY } else { bytes },
+        bytes: nodes_bytes(voxels, nodes),
     }
 }
 
@@ -216,10 +250,15 @@ mod tests {
         let mut s = biotet::SurfaceMesh::icosphere(1.0, 3);
         s.sides = vec![[1, 0]; s.triangles.len()];
         let sizing = biotet::sizing::Sizing::uniform(0.1).unwrap();
-        let e = estimate_mesh(&s, &sizing, &Default::default());
+        // Any estimate is over a zero limit.
+        let e = over_limit(&s, &sizing, &Default::default(), 0.0).unwrap();
         // The ball's volume is about 4.19 (a little less, inscribed): about 3600 nodes at 0.1.
         assert!(e.nodes > 3000.0 && e.nodes < 3700.0, "{e:?}");
         // 2.2 / 0.1 + 6 margin voxels a side.
         assert!(e.voxels > 8.0e4 && e.voxels < 1.2e5, "{e:?}");
+        // Under a limit above it: none, whether or not the sizes were sampled.
+        let d = Default::default();
+        assert!(over_limit(&s, &sizing, &d, 1.01 * e.bytes).is_none());
+        assert!(over_limit(&s, &sizing, &d, 0.99 * e.bytes).is_some());
     }
 }

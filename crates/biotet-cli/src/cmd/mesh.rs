@@ -290,9 +290,9 @@ pub fn run(a: Args) -> Result<ExitCode> {
         opts.polish = None;
     }
     // Refused before any work when the estimate exceeds --max-memory.
-    let estimate = crate::memory::estimate_mesh(&surface, &sizing, &opts.deploy);
     let limit = biotet_io::limits::max_memory();
-    if estimate.bytes > limit as f64 {
+    if let Some(estimate) = crate::memory::over_limit(&surface, &sizing, &opts.deploy, limit as f64)
+    {
         anyhow::bail!(
             "{name}: meshing needs about {} of memory (about {:.0} nodes, {:.0} template voxels), \
              more than the limit of {} (--max-memory); give a larger size or a larger limit",

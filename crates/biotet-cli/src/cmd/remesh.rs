@@ -175,8 +175,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
     let limit = biotet_io::limits::max_memory();
     let sizing = |s: &biotet::SurfaceMesh| {
         let z = Sizing::new(s, SizingOptions::new(spec()?))?;
-        let e = crate::memory::estimate_mesh(s, &z, &opts.deploy);
-        if e.bytes > limit as f64 {
+        if let Some(e) = crate::memory::over_limit(s, &z, &opts.deploy, limit as f64) {
             return Err(SizingError::OverBudget(format!(
                 "refilling a cavity needs about {} of memory (about {:.0} nodes), more than the \
                  limit of {} (--max-memory); give a larger --size or a larger limit",
