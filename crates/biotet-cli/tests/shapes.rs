@@ -201,10 +201,12 @@ fn box_in_box(path: &Path) -> String {
 }
 
 /// When recovery fails (here forbidden new points and node removal by `--no-steiner`), the
-/// error names recovery's own failures first: the triangles lost afterwards, with the outside
-/// tets the leaking labels took, were listed first as "a corner is not a mesh point".
+/// error lists recovery's own failures, and only those: the regions the unrecovered triangles
+/// join are labelled by a centroid test, so the outside no longer takes other triangles with it
+/// (they were listed first, as "a corner is not a mesh point", then after recovery's own as
+/// "removed with the outside tets").
 #[test]
-fn a_failed_recovery_names_its_own_failures_first() {
+fn a_failed_recovery_lists_only_its_own_failures() {
     let dir = tempfile::tempdir().unwrap();
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/shapes");
     let s = root.join("gen_two_cubes_apart.off");
@@ -214,13 +216,15 @@ fn a_failed_recovery_names_its_own_failures_first() {
     assert_eq!(m.status.code(), Some(1));
     assert!(!out.exists());
     let err = String::from_utf8_lossy(&m.stderr);
-    let first = err
+    let listed: Vec<&str> = err
         .lines()
-        .find(|l| l.trim_start().starts_with("triangle "))
-        .unwrap_or_else(|| panic!("no triangle listed: {err}"));
-    assert!(
-        !first.contains("not a mesh point") && !first.contains("removed with the outside"),
-        "{first}"
-    );
-    assert!(err.contains("removed with the outside tets"), "{err}");
+        .filter(|l| l.trim_start().starts_with("triangle "))
+        .collect();
+    assert!(!listed.is_empty(), "no triangle listed: {err}");
+    for l in listed {
+        assert!(
+            !l.contains("not a mesh point") && !l.contains("removed with the outside"),
+            "{l}"
+        );
+    }
 }

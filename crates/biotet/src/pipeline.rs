@@ -15,7 +15,7 @@ use crate::lastresort::{
     ImproveOptions, ImproveReport, RecoverError, RecoverOptions, RecoverReport, improve,
 };
 use crate::mesh::coord_key;
-use crate::mesh::inside::{Location, RegionLocator, Transitions};
+use crate::mesh::inside::{RegionLocator, Transitions, centroid_region};
 use crate::mesh::surface::SurfaceMesh;
 use crate::mesh::tet::{NO_NEIGHBOR, TetMesh};
 use crate::polish::{PolishOptions, PolishReport, polish};
@@ -101,7 +101,9 @@ pub struct MeshReport {
     pub n_interior_nodes: usize,
     /// Finite tets of the Delaunay tetrahedralization (the convex hull).
     pub n_delaunay_tets: usize,
-    /// Tets whose inside/outside status needed a centroid test (two or more surface vertices).
+    /// Tets whose region needed a centroid test (two or more surface corners); with recovery,
+    /// only those of the regions its flood fill cannot label (none when every triangle is
+    /// recovered).
     pub n_centroid_tests: usize,
     /// Tets kept (inside a region).
     pub n_tets: usize,
@@ -319,28 +321,35 @@ fn tetrahedralize(
         points = (0..n_points).map(|i| points[map[i] as usize]).collect();
     }
     drop(map);
-    // Labels: tets with two or more surface corners by a centroid test, the others by their
-    // interior node's region (on all threads; the order, and so the result, is fixed).
-    let locator = RegionLocator::new(surface);
+    // Labels: tets with an interior node by its region; the others (two or more surface corners)
+    // by a centroid test, on all threads (the order, and so the result, is fixed). With recovery
+    // to follow, the centroid tests wait: its flood fill labels every tet once the surface is
+    // recovered, and it tests only the tets of the regions it cannot label.
+    let locator = recover.is_none().then(|| RegionLocator::new(surface));
     let mut labels: Vec<u32> = Vec::new();
     tets.par_iter()
         .map_init(Transitions::default, |scratch, v| {
-            if v.iter().filter(|&&x| x < ns).count() >= 2 {
-                centroid_region(v.map(|x| points[x as usize]), &locator, scratch)
-            } else {
-                let i = v.iter().find(|&&x| x >= ns).copied().unwrap_or(0);
-                regions[(i - ns) as usize]
+            match (v.iter().find(|&&x| x >= ns), &locator) {
+                (Some(&i), _) if v.iter().filter(|&&x| x < ns).count() < 2 => {
+                    regions[(i - ns) as usize]
+                }
+                (_, Some(locator)) => {
+                    centroid_region(v.map(|x| points[x as usize]), locator, scratch)
+                }
+                (_, None) => 0,
             }
         })
         .collect_into_vec(&mut labels);
-    report.n_centroid_tests = tets
-        .iter()
-        .filter(|v| v.iter().filter(|&&x| x < ns).count() >= 2)
-        .count();
+    if locator.is_some() {
+        report.n_centroid_tests = tets
+            .iter()
+            .filter(|v| v.iter().filter(|&&x| x < ns).count() >= 2)
+            .count();
+    }
     drop((locator, regions));
     // With recovery to follow, every tet is kept: recovery works on the convex hull and labels
-    // by flood fill across the recovered surface; the centroid labels stay only where it cannot
-    // (triangles left unrecovered). Without it, the outside tets go here.
+    // by flood fill across the recovered surface (centroid tests only where it cannot: triangles
+    // left unrecovered). Without it, the outside tets go here.
     if recover.is_none() {
         keep_labelled(&mut tets, &mut neighbors, &mut labels);
     }
@@ -350,7 +359,9 @@ fn tetrahedralize(
     if let Some(o) = recover {
         progress("recovering the boundary");
         let clock = Instant::now();
-        report.recover = Some(recover_built(&mut mesh, surface, o)?);
+        let r = recover_built(&mut mesh, surface, o, true)?;
+        report.n_centroid_tests = r.centroid_tests;
+        report.recover = Some(r);
         // Recovery drops the outside tets; drop the points only they used.
         let TetMesh {
             points,
@@ -483,24 +494,6 @@ fn clear_nodes(nodes: &mut Nodes, balls: &[([f64; 3], f64)]) -> usize {
 fn extent(points: &[[f64; 3]]) -> f64 {
     let (lo, hi) = crate::geom::vec3::points_bbox(points.iter());
     (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max)
-}
-
-/// Region of a tet by its centroid; if the centroid lies exactly on the surface, other interior
-/// points of the tet decide.
-fn centroid_region(c: [[f64; 3]; 4], locator: &RegionLocator, scratch: &mut Transitions) -> u32 {
-    for w in [
-        [1.0, 1.0, 1.0, 1.0],
-        [2.0, 1.0, 1.0, 1.0],
-        [1.0, 2.0, 1.0, 1.0],
-        [1.0, 1.0, 2.0, 1.0],
-    ] {
-        let s: f64 = w.iter().sum();
-        let p = [0, 1, 2].map(|a| (0..4).map(|k| w[k] * c[k][a]).sum::<f64>() / s);
-        if let Location::Region(r) = locator.locate_with(p, scratch) {
-            return r;
-        }
-    }
-    0
 }
 
 /// Drop the tets labelled 0 (outside), in place, keeping the others' order; their neighbours

@@ -80,6 +80,7 @@ use crate::geom::filter::orient3d;
 use crate::geom::intersect::{TriTri, tri_tri};
 use crate::geom::predicates::{Sign, in_exact_range};
 use crate::mesh::coord_key;
+use crate::mesh::inside::{RegionLocator, Transitions, centroid_region};
 use crate::mesh::surface::SurfaceMesh;
 use crate::mesh::tet::{NO_NEIGHBOR, TET_FACES, TetMesh, sorted3};
 use crate::quality::tri::min_angle_3d_deg;
@@ -250,6 +251,9 @@ pub struct RecoverReport {
     /// Regions whose surrounding surface triangles disagree about their label (left as they
     /// were; only when some triangle is unrecovered).
     pub label_conflicts: usize,
+    /// Tets of such regions (or of regions no surface triangle bounds) labelled by a centroid
+    /// test, when the pipeline left their labels to recovery.
+    pub centroid_tests: usize,
     /// Total wall time in milliseconds.
     pub total_ms: f64,
     /// The triangles still missing.
@@ -273,26 +277,31 @@ pub fn recover(
 ) -> Result<RecoverReport, RecoverError> {
     let t0 = Instant::now();
     validate_inputs(mesh, surface, true)?;
-    recover_checked(mesh, surface, opts, t0)
+    recover_checked(mesh, surface, opts, false, t0)
 }
 
 /// [`recover`] on a mesh valid by construction (the pipeline's: positive tets from the exact
 /// Delaunay, its adjacency kept): the tet orientations and the adjacency are not checked again
-/// (a quarter of recovery's time on brain_20k), except in debug builds.
+/// (a quarter of recovery's time on brain_20k), except in debug builds. With `deferred`, the
+/// labels of the tets with two or more surface corners were not computed (the flood fill
+/// labels every tet once the surface is recovered): the tets of a region it cannot label get a
+/// centroid test instead of keeping their labels.
 pub(crate) fn recover_built(
     mesh: &mut TetMesh,
     surface: &SurfaceMesh,
     opts: &RecoverOptions,
+    deferred: bool,
 ) -> Result<RecoverReport, RecoverError> {
     let t0 = Instant::now();
     validate_inputs(mesh, surface, cfg!(debug_assertions))?;
-    recover_checked(mesh, surface, opts, t0)
+    recover_checked(mesh, surface, opts, deferred, t0)
 }
 
 fn recover_checked(
     mesh: &mut TetMesh,
     surface: &SurfaceMesh,
     opts: &RecoverOptions,
+    deferred: bool,
     t0: Instant,
 ) -> Result<RecoverReport, RecoverError> {
     let tets_before = mesh.tets.len();
@@ -346,7 +355,7 @@ fn recover_checked(
     let left: FxHashSet<u32> = r.missing_mapped().collect();
     r.compact();
     // Also sets the final `is_present`.
-    let (removed, conflicts) = r.relabel();
+    let (removed, conflicts, centroid_tests) = r.relabel(deferred);
 
     if cfg!(debug_assertions) {
         r.assert_present();
@@ -400,6 +409,7 @@ fn recover_checked(
         surface_points_reinserted: reinserted,
         outside_tets_removed: removed,
         label_conflicts: conflicts,
+        centroid_tests,
         total_ms: t0.elapsed().as_secs_f64() * 1e3,
         unrecovered,
     };
@@ -2154,10 +2164,15 @@ impl<'a> Recovery<'a> {
         before - k
     }
 
+    /// Whether mesh point `x` is a corner of some surface triangle.
+    fn is_surface_point(&self, x: u32) -> bool {
+        self.surf_start[x as usize] != self.surf_start[x as usize + 1]
+    }
+
     /// Flood-fill region labels from the surface's side labels and remove region 0; sets
     /// [`Self::is_present`] for the output. Returns (tets removed, regions with conflicting
     /// votes).
-    fn relabel(&mut self) -> (usize, usize) {
+    fn relabel(&mut self, deferred: bool) -> (usize, usize, usize) {
         // Which tet faces are surface triangles, looked up in parallel: one bit a face (a byte a
         // tet, not 16), the few walls looked up again when met.
         let view = self.view();
@@ -2180,6 +2195,7 @@ impl<'a> Recovery<'a> {
         let n = self.mesh.tets.len();
         let mut comp = vec![u32::MAX; n];
         let mut conflicts = 0;
+        let (mut locator, mut tally, mut tested) = (None, Transitions::default(), 0);
         let mut stack = Vec::new();
         let mut members = Vec::new();
         for seed in 0..n {
@@ -2218,10 +2234,27 @@ impl<'a> Recovery<'a> {
             }
             if conflict {
                 conflicts += 1;
-            } else if let Some(l) = vote {
-                for &t in &members {
-                    self.mesh.labels[t as usize] = l;
+            }
+            match vote {
+                Some(l) if !conflict => {
+                    for &t in &members {
+                        self.mesh.labels[t as usize] = l;
+                    }
                 }
+                // Labels the pipeline left to the flood fill: a centroid test.
+                _ if deferred => {
+                    let locator = locator.get_or_insert_with(|| RegionLocator::new(self.surface));
+                    for &t in &members {
+                        let v = self.mesh.tets[t as usize];
+                        let on = v.iter().filter(|&&x| self.is_surface_point(x)).count();
+                        if on >= 2 {
+                            let c = v.map(|x| self.mesh.points[x as usize]);
+                            self.mesh.labels[t as usize] = centroid_region(c, locator, &mut tally);
+                            tested += 1;
+                        }
+                    }
+                }
+                _ => {}
             }
         }
         drop(comp);
@@ -2241,10 +2274,10 @@ impl<'a> Recovery<'a> {
         }
         drop(walls);
         if !self.opts.remove_outside {
-            return (0, conflicts);
+            return (0, conflicts, tested);
         }
         let removed = self.remove_outside();
-        (removed, conflicts)
+        (removed, conflicts, tested)
     }
 
     /// Remove the tets labelled 0.

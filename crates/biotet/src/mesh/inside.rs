@@ -305,6 +305,28 @@ impl<'a> RegionLocator<'a> {
     }
 }
 
+/// Region of a tet (corners `c`) by its centroid; if the centroid lies exactly on the surface, other interior
+/// points of the tet decide.
+pub fn centroid_region(
+    c: [[f64; 3]; 4],
+    locator: &RegionLocator,
+    scratch: &mut Transitions,
+) -> u32 {
+    for w in [
+        [1.0, 1.0, 1.0, 1.0],
+        [2.0, 1.0, 1.0, 1.0],
+        [1.0, 2.0, 1.0, 1.0],
+        [1.0, 1.0, 2.0, 1.0],
+    ] {
+        let s: f64 = w.iter().sum();
+        let p = [0, 1, 2].map(|a| (0..4).map(|k| w[k] * c[k][a]).sum::<f64>() / s);
+        if let Location::Region(r) = locator.locate_with(p, scratch) {
+            return r;
+        }
+    }
+    0
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

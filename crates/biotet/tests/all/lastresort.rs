@@ -804,3 +804,34 @@ fn recovery_proves_a_cell_empty_before_filling_the_others() {
     assert!(c.valid, "{c}");
     assert!((mesh_volume(&m) - 1.0).abs() < 1e-12);
 }
+
+/// Without new points the twisted cube cannot be recovered whole, and the flood fill cannot
+/// label the regions a missing face joins. Their tets get a centroid test on the mesh recovery
+/// left (the pipeline leaves those labels to recovery): the whole cube stays, and only the
+/// triangles recovery itself left are missing. With the labels the Delaunay's tets had, the
+/// outside took four more triangles and a third of the cube.
+#[test]
+fn an_unrecovered_cube_keeps_its_inside() {
+    use biotet::pipeline::{PipelineOptions, mesh_surface};
+    let s = twisted_cube();
+    let sizing = crate::common::default_sizing(&s);
+    let mut opts = PipelineOptions::default();
+    if let Some(r) = opts.recover.as_mut() {
+        r.allow_interior_steiner = false;
+    }
+    if let Some(p) = opts.polish.as_mut() {
+        p.insert = false;
+    }
+    let (m, report) = mesh_surface(&s, &sizing, &opts, &mut |_| {}).unwrap();
+    let r = report.recover.as_ref().unwrap();
+    assert!(r.label_conflicts > 0 && r.centroid_tests > 0, "{r:?}");
+    assert_eq!(report.n_centroid_tests, r.centroid_tests);
+    assert!(!r.unrecovered.is_empty());
+    for u in &r.unrecovered {
+        assert!(u.reason.contains("search exhausted"), "{u:?}");
+    }
+    assert_eq!(r.missing_after, r.unrecovered.len());
+    let c = check(&m, None);
+    assert!(c.valid, "{c}");
+    assert!((mesh_volume(&m) - 1.0).abs() < 1e-12, "{}", mesh_volume(&m));
+}
