@@ -329,14 +329,13 @@ fn tetrahedralize(
     let mut labels: Vec<u32> = Vec::new();
     tets.par_iter()
         .map_init(Transitions::default, |scratch, v| {
-            match (v.iter().find(|&&x| x >= ns), &locator) {
-                (Some(&i), _) if v.iter().filter(|&&x| x < ns).count() < 2 => {
-                    regions[(i - ns) as usize]
-                }
-                (_, Some(locator)) => {
-                    centroid_region(v.map(|x| points[x as usize]), locator, scratch)
-                }
-                (_, None) => 0,
+            if v.iter().filter(|&&x| x < ns).count() < 2 {
+                let i = v.iter().find(|&&x| x >= ns).copied().unwrap_or(0);
+                regions[(i - ns) as usize]
+            } else if let Some(locator) = &locator {
+                centroid_region(v.map(|x| points[x as usize]), locator, scratch)
+            } else {
+                0
             }
         })
         .collect_into_vec(&mut labels);

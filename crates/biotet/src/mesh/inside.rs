@@ -305,8 +305,8 @@ impl<'a> RegionLocator<'a> {
     }
 }
 
-/// Region of a tet (corners `c`) by its centroid; if the centroid lies exactly on the surface, other interior
-/// points of the tet decide.
+/// Region of a tet (corners `c`) by its centroid; if the centroid lies exactly on the surface,
+/// other interior points of the tet decide.
 pub fn centroid_region(
     c: [[f64; 3]; 4],
     locator: &RegionLocator,

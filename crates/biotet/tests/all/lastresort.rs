@@ -792,10 +792,8 @@ fn a_cube_whose_diagonals_twist_gets_one_interior_point() {
 /// search nodes when the cells were searched in their own order, 16 now.
 #[test]
 fn recovery_proves_a_cell_empty_before_filling_the_others() {
-    use biotet::pipeline::{PipelineOptions, mesh_surface};
     let s = twisted_cube();
-    let sizing = crate::common::default_sizing(&s);
-    let (m, report) = mesh_surface(&s, &sizing, &PipelineOptions::default(), &mut |_| {}).unwrap();
+    let (m, report) = mesh_pipeline(&s, biotet::pipeline::PipelineOptions::default());
     let r = report.recover.as_ref().unwrap();
     assert!(r.is_complete(), "{r:?}");
     assert_eq!(r.steiner_points, 1);
@@ -805,6 +803,15 @@ fn recovery_proves_a_cell_empty_before_filling_the_others() {
     assert!((mesh_volume(&m) - 1.0).abs() < 1e-12);
 }
 
+/// `s` meshed by the pipeline at its default size.
+fn mesh_pipeline(
+    s: &SurfaceMesh,
+    opts: biotet::pipeline::PipelineOptions,
+) -> (TetMesh, biotet::pipeline::MeshReport) {
+    let sizing = crate::common::default_sizing(s);
+    biotet::pipeline::mesh_surface(s, &sizing, &opts, &mut |_| {}).unwrap()
+}
+
 /// Without new points the twisted cube cannot be recovered whole, and the flood fill cannot
 /// label the regions a missing face joins. Their tets get a centroid test on the mesh recovery
 /// left (the pipeline leaves those labels to recovery): the whole cube stays, and only the
@@ -812,17 +819,15 @@ fn recovery_proves_a_cell_empty_before_filling_the_others() {
 /// outside took four more triangles and a third of the cube.
 #[test]
 fn an_unrecovered_cube_keeps_its_inside() {
-    use biotet::pipeline::{PipelineOptions, mesh_surface};
     let s = twisted_cube();
-    let sizing = crate::common::default_sizing(&s);
-    let mut opts = PipelineOptions::default();
+    let mut opts = biotet::pipeline::PipelineOptions::default();
     if let Some(r) = opts.recover.as_mut() {
         r.allow_interior_steiner = false;
     }
     if let Some(p) = opts.polish.as_mut() {
         p.insert = false;
     }
-    let (m, report) = mesh_surface(&s, &sizing, &opts, &mut |_| {}).unwrap();
+    let (m, report) = mesh_pipeline(&s, opts);
     let r = report.recover.as_ref().unwrap();
     assert!(r.label_conflicts > 0 && r.centroid_tests > 0, "{r:?}");
     assert_eq!(report.n_centroid_tests, r.centroid_tests);
