@@ -123,6 +123,35 @@ pub fn closest_on_triangle(p: P3, t: &[P3; 3]) -> P3 {
     add(a, add(scale(ab, v), scale(ac, w)))
 }
 
+/// The squared distance from `p` to triangle `t` if it is at most `r2` (`r` its root), else
+/// `None`: after two cheap rejections, the triangle's box grown by `r` and the distance to its
+/// plane (both bound the distance from below; a relative margin of 1e-9 keeps rounding from
+/// deciding a borderline case differently from `dist2(p, closest_on_triangle(p, t)) <= r2`).
+#[inline]
+pub fn within_d2(p: P3, t: &[P3; 3], r: f64, r2: f64) -> Option<f64> {
+    let m = r * (1.0 + 1e-9);
+    for k in 0..3 {
+        let lo = t[0][k].min(t[1][k]).min(t[2][k]);
+        let hi = t[0][k].max(t[1][k]).max(t[2][k]);
+        if p[k] < lo - m || p[k] > hi + m {
+            return None;
+        }
+    }
+    let n = cross(sub(t[1], t[0]), sub(t[2], t[0]));
+    let h = dot(sub(p, t[0]), n);
+    if h * h > r2 * dot(n, n) * (1.0 + 1e-9) {
+        return None;
+    }
+    let d2 = dist2(p, closest_on_triangle(p, t));
+    (d2 <= r2).then_some(d2)
+}
+
+/// Whether `p` is within `sqrt(r2)` of triangle `t` ([`within_d2`]).
+#[inline]
+pub fn within(p: P3, t: &[P3; 3], r: f64, r2: f64) -> bool {
+    within_d2(p, t, r, r2).is_some()
+}
+
 /// The closest point of segment `uv` to `p`.
 pub fn closest_on_segment(p: P3, u: P3, v: P3) -> P3 {
     let d = sub(v, u);
@@ -256,38 +285,54 @@ impl Bvh {
     /// most queries cost a distance or two instead of a descent); the answer does not depend on
     /// it.
     pub fn any_within_hinted(&self, p: P3, r2: f64, hint: &mut Hint) -> bool {
+        self.first_within_hinted(p, r2, hint).is_some()
+    }
+
+    /// The squared distance to the first triangle [`Self::any_within_hinted`] finds within
+    /// `sqrt(r2)` of `p`: an upper bound on the distance to the set, found as cheaply.
+    pub fn first_within_hinted(&self, p: P3, r2: f64, hint: &mut Hint) -> Option<f64> {
         if self.nodes.is_empty() {
-            return false;
+            return None;
         }
+        let r = r2.sqrt();
         for i in 0..HINTS {
             let k = hint.0[i];
             if k == u32::MAX {
                 break;
             }
-            if dist2(p, closest_on_triangle(p, &self.tris[k as usize])) <= r2 {
+            if let Some(d2) = within_d2(p, &self.tris[k as usize], r, r2) {
                 hint.note(k);
-                return true;
+                return Some(d2);
             }
         }
-        let mut stack: Vec<u32> = Vec::with_capacity(64);
-        stack.push(0);
-        while let Some(i) = stack.pop() {
+        // Depth first, so the stack never holds more than the tree's depth plus one.
+        let mut stack = [0u32; 128];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let i = stack[top];
             let node = &self.nodes[i as usize];
             if box_d2(p, node.lo, node.hi) > r2 {
                 continue;
             }
             if node.count > 0 {
                 for &k in &self.order[node.start as usize..(node.start + node.count) as usize] {
-                    if dist2(p, closest_on_triangle(p, &self.tris[k as usize])) <= r2 {
+                    if let Some(d2) = within_d2(p, &self.tris[k as usize], r, r2) {
                         hint.note(k);
-                        return true;
+                        return Some(d2);
                     }
                 }
             } else {
-                self.push_children(p, i, node.start, &mut stack);
+                let (l, rr) = (i + 1, node.start);
+                let dl = box_d2(p, self.nodes[l as usize].lo, self.nodes[l as usize].hi);
+                let dr = box_d2(p, self.nodes[rr as usize].lo, self.nodes[rr as usize].hi);
+                let (first, second) = if dl <= dr { (rr, l) } else { (l, rr) };
+                stack[top] = first;
+                stack[top + 1] = second;
+                top += 2;
             }
         }
-        false
+        None
     }
 
     /// The closest point to `p` (`None` only for an empty index).

@@ -1,33 +1,28 @@
 //! The input side of the distance bound during remeshing: sample points of the input (every
-//! corner and a barycentric grid on each triangle), bucketed in a uniform grid, so an operation
-//! can check that the input near the triangles it replaces stays within the tolerance of the
-//! surface that replaces them.
-
-use rustc_hash::FxHashMap;
+//! corner and a barycentric grid on each triangle), each with the triangle it was taken from, so
+//! the remesher can give every sample a covering triangle and check, when an operation replaces
+//! triangles, that the samples they covered stay within the tolerance of the surface.
 
 use super::bvh::dist2;
 use crate::mesh::surface::SurfaceMesh;
 
 type P3 = [f64; 3];
 
-/// Input samples in a hashed grid.
+/// Input samples.
 #[derive(Debug, Clone, Default)]
 pub struct InputSamples {
     /// Sample points.
     pub pts: Vec<P3>,
     /// Side labels of the triangle each sample came from.
     pub sides: Vec<[u32; 2]>,
-    h: f64,
-    cells: FxHashMap<[i32; 3], Vec<u32>>,
+    /// The triangle each sample came from.
+    pub tri: Vec<u32>,
 }
 
 impl InputSamples {
-    /// Sample `s` with grid step at most `spacing` on each triangle; cells of size `h`.
-    pub fn new(s: &SurfaceMesh, spacing: f64, h: f64) -> InputSamples {
-        let mut out = InputSamples {
-            h,
-            ..Default::default()
-        };
+    /// Sample `s` with grid step at most `spacing` on each triangle.
+    pub fn new(s: &SurfaceMesh, spacing: f64) -> InputSamples {
+        let mut out = InputSamples::default();
         let mut first = vec![u32::MAX; s.points.len()];
         for (t, tri) in s.triangles.iter().enumerate().rev() {
             for &v in tri {
@@ -55,39 +50,12 @@ impl InputSamples {
                     {
                         continue;
                     }
-                    let id = out.pts.len() as u32;
                     out.pts.push(p);
                     out.sides.push(s.sides[t]);
-                    out.cells.entry(out.cell(p)).or_default().push(id);
+                    out.tri.push(t as u32);
                 }
             }
         }
         out
-    }
-
-    fn cell(&self, p: P3) -> [i32; 3] {
-        p.map(|c| (c / self.h).floor() as i32)
-    }
-
-    /// The samples in the box `lo..hi`, in index order.
-    pub fn in_box(&self, lo: P3, hi: P3, out: &mut Vec<u32>) {
-        out.clear();
-        let a = self.cell(lo);
-        let b = self.cell(hi);
-        for i in a[0]..=b[0] {
-            for j in a[1]..=b[1] {
-                for k in a[2]..=b[2] {
-                    if let Some(v) = self.cells.get(&[i, j, k]) {
-                        for &s in v {
-                            let p = self.pts[s as usize];
-                            if (0..3).all(|x| p[x] >= lo[x] && p[x] <= hi[x]) {
-                                out.push(s);
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        out.sort_unstable();
     }
 }

@@ -275,7 +275,7 @@ pub fn improve(
     let f = features::find(surface, opts.feature_angle_deg);
     let index = PatchIndex::new(&surface.points, &surface.triangles, &surface.sides, None);
     // Input samples for the in→out guard, spaced D (at least a quarter edge length).
-    let samples = guard::InputSamples::new(surface, d.max(l / 4.0), l);
+    let samples = guard::InputSamples::new(surface, d.max(l / 4.0));
     let point_size = if opts.adaptive {
         size::point_sizes(surface, 0.7 * d, l / 2.0, l, 0.5)
     } else {

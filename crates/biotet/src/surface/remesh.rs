@@ -8,17 +8,25 @@
 //!   new triangle meeting any other triangle except in their shared corners or edge
 //!   ([`crate::geom::intersect::tri_tri`], exact), candidates from a [`Grid`];
 //! - distance: sample points on every new triangle within the working tolerance of the input
-//!   sheet with the same side labels, and a removed point (which lay on the input) within it of
-//!   the triangles that replace it;
+//!   sheet with the same side labels, a removed point (which lay on the input) within it of
+//!   the triangles that replace it, and every input sample ([`InputSamples`]) covered: each
+//!   has a triangle within the tolerance, and an operation must find new ones for the samples
+//!   its old triangles covered;
 //! - shape: no new triangle with a smaller angle than the worst of the triangles it replaces,
 //!   unless it is above the target angle.
+//!
+//! Distances are bounded rather than recomputed where a bound suffices: each triangle keeps an
+//! upper bound on its samples' distance to the input and each input sample one on its distance
+//! to its covering triangle, and a point move by `m` moves every point of its triangles by at
+//! most `m` (by `w m` at barycentric weight `w`), so a bound plus that move within the
+//! tolerance needs no distance computed. Each shortcut answers as the full test would.
 //!
 //! The loop is sequential and visits edges and points in index order, so its output depends on
 //! the input alone.
 
 use rustc_hash::FxHashSet;
 
-use super::bvh::{Hint, PatchIndex, closest_on_triangle, dist2, unit_normal};
+use super::bvh::{Hint, PatchIndex, closest_on_triangle, dist2, unit_normal, within, within_d2};
 use super::features::{Features, key};
 use super::grid::Grid;
 use super::guard::InputSamples;
@@ -36,13 +44,33 @@ pub fn angles_deg(t: &[P3; 3]) -> (f64, f64) {
     let mut lo = 180.0f64;
     let mut hi = 0.0f64;
     for k in 0..3 {
-        let u = sub(t[(k + 1) % 3], t[k]);
-        let v = sub(t[(k + 2) % 3], t[k]);
-        let a = norm(cross(u, v)).atan2(dot(u, v)).to_degrees();
+        let a = angle_at(t, k);
         lo = lo.min(a);
         hi = hi.max(a);
     }
     (lo, hi)
+}
+
+/// The angle of triangle `t` at corner `k`, in degrees (the formula of [`angles_deg`]).
+#[inline]
+fn angle_at(t: &[P3; 3], k: usize) -> f64 {
+    let u = sub(t[(k + 1) % 3], t[k]);
+    let v = sub(t[(k + 2) % 3], t[k]);
+    norm(cross(u, v)).atan2(dot(u, v)).to_degrees()
+}
+
+/// `angles_deg(t).0` with one arc tangent instead of three where the shortest edge is shorter
+/// than the others by a margin (the smallest angle faces it; a near tie computes all three, so
+/// the value is the same to the last bit).
+pub fn min_angle_deg(t: &[P3; 3]) -> f64 {
+    let e = [0, 1, 2].map(|k| dist2(t[(k + 1) % 3], t[(k + 2) % 3]));
+    let k = (0..3).min_by(|&a, &b| e[a].total_cmp(&e[b])).unwrap_or(0);
+    let margin = 1.0 - 1e-9;
+    if (0..3).all(|j| j == k || e[k] < e[j] * margin) {
+        angle_at(t, k)
+    } else {
+        angles_deg(t).0
+    }
 }
 
 /// Counts of applied operations.
@@ -73,6 +101,14 @@ pub struct Remesher<'a> {
     feature: FxHashSet<(u32, u32)>,
     input: &'a PatchIndex,
     samples: &'a InputSamples,
+    /// Per input sample: the triangle that covers it (within the working tolerance) and an
+    /// upper bound on its distance to it.
+    cover: Vec<(u32, f64)>,
+    /// Per triangle: the input samples it covers.
+    covers: Vec<Vec<u32>>,
+    /// Per triangle: an upper bound on the distance of its samples to the input, and their
+    /// number per edge (0: unknown).
+    dev: Vec<(f64, u8)>,
     tri_size: &'a [f64],
     /// Target edge length per point.
     pub size: Vec<f64>,
@@ -89,8 +125,6 @@ pub struct Remesher<'a> {
     pub counts: OpCounts,
     /// Repair mode: a projection may lower the smallest angle (the distance comes first).
     pub repairing: bool,
-    scratch: Vec<u32>,
-    scratch2: Vec<u32>,
 }
 
 impl<'a> Remesher<'a> {
@@ -108,6 +142,11 @@ impl<'a> Remesher<'a> {
     ) -> Remesher<'a> {
         let mut vt = vec![Vec::new(); s.points.len()];
         let mut grid = Grid::new(l.max(1e-300));
+        // Each sample starts on the triangle it was taken from.
+        let mut covers = vec![Vec::new(); s.triangles.len()];
+        for (i, &t) in samples.tri.iter().enumerate() {
+            covers[t as usize].push(i as u32);
+        }
         for (t, tri) in s.triangles.iter().enumerate() {
             for &v in tri {
                 vt[v as usize].push(t as u32);
@@ -124,6 +163,9 @@ impl<'a> Remesher<'a> {
             feature: f.edges.clone(),
             input,
             samples,
+            cover: samples.tri.iter().map(|&t| (t, 0.0)).collect(),
+            covers,
+            dev: vec![(f64::INFINITY, 0); s.triangles.len()],
             tri_size,
             size: point_size.to_vec(),
             grid,
@@ -133,8 +175,6 @@ impl<'a> Remesher<'a> {
             target_angle: 30.0,
             counts: OpCounts::default(),
             repairing: false,
-            scratch: Vec::new(),
-            scratch2: Vec::new(),
         }
     }
 
@@ -210,111 +250,169 @@ impl<'a> Remesher<'a> {
             .any(|&t| self.tris[t as usize].contains(&b))
     }
 
-    /// Every sample of triangle `c` within the working tolerance of the input sheet `sides`.
-    fn near_input(&self, c: &[P3; 3], sides: [u32; 2]) -> bool {
-        let Some(bvh) = self.input.get(sides) else {
-            return false;
-        };
+    /// The samples of triangle `c` per edge ([`Self::near_input`]).
+    fn sample_count(&self, c: &[P3; 3]) -> u8 {
         let longest = (0..3)
             .map(|k| dist2(c[k], c[(k + 1) % 3]))
             .fold(0.0, f64::max)
             .sqrt();
-        let n = ((longest / self.spacing).ceil() as usize).clamp(2, 6);
+        ((longest / self.spacing).ceil() as usize).clamp(2, 6) as u8
+    }
+
+    /// Whether every sample of triangle `c` (a barycentric grid of `n` steps an edge) is within
+    /// the working tolerance of the input sheet `sides`: then an upper bound on their largest
+    /// distance to it, else `None`.
+    ///
+    /// `known = Some((k, d, m))` says that `c` is a triangle whose samples (at this `n`) were
+    /// within `d` of the input, with corner `k` since moved by `m`: a sample of weight `w` at
+    /// that corner moved by `w m`, so it is within `d + w m`, and where that is within the
+    /// tolerance no distance is computed (the samples on the opposite edge did not move).
+    fn near_input(
+        &self,
+        c: &[P3; 3],
+        sides: [u32; 2],
+        n: u8,
+        known: Option<(usize, f64, f64)>,
+    ) -> Option<f64> {
+        let bvh = self.input.get(sides)?;
+        let n = n as usize;
         let t2 = self.tol * self.tol;
+        let lim = self.tol * (1.0 - 1e-9);
         let mut hint = Hint::default();
+        let mut worst = 0.0f64;
         for i in 0..=n {
             for j in 0..=n - i {
                 let k = n - i - j;
                 let w = [i as f64, j as f64, k as f64].map(|x| x / n as f64);
-                let p = [0, 1, 2].map(|a| w[0] * c[0][a] + w[1] * c[1][a] + w[2] * c[2][a]);
-                if !bvh.any_within_hinted(p, t2, &mut hint) {
-                    return false;
+                if let Some((corner, d, m)) = known {
+                    let b = d + w[corner] * m;
+                    if b <= lim {
+                        worst = worst.max(b * b);
+                        continue;
+                    }
                 }
+                let p = [0, 1, 2].map(|a| w[0] * c[0][a] + w[1] * c[1][a] + w[2] * c[2][a]);
+                worst = worst.max(bvh.first_within_hinted(p, t2, &mut hint)?);
             }
         }
-        true
+        Some(worst.sqrt())
     }
 
-    /// Whether the input stays within the working tolerance when the triangles `old` (all with
-    /// side labels `sides`, corners `old_c`) are replaced by `new`: every input sample of that
-    /// sheet within it of an old triangle is within it of a new triangle or of a triangle that
-    /// stays. Samples farther from every old triangle need no test: every sample is within the
-    /// tolerance of the current surface (it starts as the input, each operation keeps it so, and
-    /// the tolerance never shrinks), so those are covered by triangles that stay.
-    fn input_kept(
-        &mut self,
-        old_c: &[[P3; 3]],
+    /// [`Self::near_input`] for each of the proposed triangles `new` (with the side labels of
+    /// `ids`): their bounds, or `None` if one strays. With `moved = Some((v, m))`, `new[k]` is
+    /// triangle `ids[k]` with its corner `v` moved by `m`, so where it keeps its number of
+    /// samples their old bound serves ([`Self::near_input`]'s `known`).
+    fn new_near_input(
+        &self,
         new: &[([u32; 3], [P3; 3])],
+        ids: &[u32],
+        moved: Option<(u32, f64)>,
+    ) -> Option<Vec<(f64, u8)>> {
+        new.iter()
+            .zip(ids)
+            .map(|((tri, c), &t)| {
+                let n = self.sample_count(c);
+                let (d, dn) = self.dev[t as usize];
+                let known = moved.and_then(|(v, m)| {
+                    let corner = tri.iter().position(|&x| x == v)?;
+                    (dn == n).then_some((corner, d, m))
+                });
+                self.near_input(c, self.sides[t as usize], n, known)
+                    .map(|d| (d, n))
+            })
+            .collect()
+    }
+
+    /// The new covers of the input samples covered by the triangles `old` when they are
+    /// replaced by `new` (triangle `new_ids[k]` takes the corners `new[k]`; the other old ones
+    /// go), or `None` if one of them would be farther than the working tolerance from every new
+    /// triangle and every triangle that stays. Samples covered by a triangle that stays stay
+    /// covered, so this keeps every input sample within the tolerance of the surface.
+    ///
+    /// `moved` > 0 says that `new[k]` is `old[k]` with one corner moved by that distance (a
+    /// point move): every point of the old triangle is within `moved` of the new one, so a
+    /// sample whose bound plus `moved` is within the tolerance needs no distance computed.
+    fn recover_samples(
+        &self,
         old: &[u32],
-        sides: [u32; 2],
-    ) -> bool {
+        new: &[([u32; 3], [P3; 3])],
+        new_ids: &[u32],
+        moved: f64,
+    ) -> Option<Vec<(u32, u32, f64)>> {
         let tol = self.tol;
         let t2 = tol * tol;
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        let boxes: Vec<(P3, P3)> = old_c
-            .iter()
-            .map(|c| {
-                let (a, b) = bbox(c);
-                (a.map(|x| x - tol), b.map(|x| x + tol))
-            })
-            .collect();
-        for (a, b) in &boxes {
-            for k in 0..3 {
-                lo[k] = lo[k].min(a[k]);
-                hi[k] = hi[k].max(b[k]);
-            }
-        }
-        let mut near = std::mem::take(&mut self.scratch2);
-        self.samples.in_box(lo, hi, &mut near);
-        let mut ok = true;
+        let lim = tol * (1.0 - 1e-9);
+        let mut plan = Vec::new();
+        let mut cand = Vec::new();
         // The new triangle that covered the last sample is tried first (neighbouring samples
         // mostly share it).
         let mut last = 0;
-        for &s in &near {
-            if self.samples.sides[s as usize] != sides {
-                continue;
-            }
-            let p = self.samples.pts[s as usize];
-            let near_old = old_c.iter().zip(&boxes).any(|(c, (a, b))| {
-                (0..3).all(|k| p[k] >= a[k] && p[k] <= b[k])
-                    && dist2(p, closest_on_triangle(p, c)) <= t2
-            });
-            if !near_old {
-                continue;
-            }
-            let within = |k: usize| dist2(p, closest_on_triangle(p, &new[k].1)) <= t2;
-            if !new.is_empty() && within(last) {
-                continue;
-            }
-            if let Some(k) = (0..new.len()).find(|&k| k != last && within(k)) {
-                last = k;
-                continue;
-            }
-            // The triangles that stay.
-            let mut cand = std::mem::take(&mut self.scratch);
-            self.grid
-                .query(p.map(|x| x - tol), p.map(|x| x + tol), &mut cand);
-            let kept = cand.iter().any(|&u| {
-                self.alive[u as usize]
-                    && !old.contains(&u)
-                    && self.sides[u as usize] == sides
-                    && dist2(p, closest_on_triangle(p, &self.corners(u))) <= t2
-            });
-            self.scratch = cand;
-            if !kept {
-                ok = false;
-                break;
+        for &t in old {
+            for &s in &self.covers[t as usize] {
+                let d = self.cover[s as usize].1;
+                if moved > 0.0 && d + moved <= lim {
+                    plan.push((s, t, d + moved));
+                    continue;
+                }
+                let p = self.samples.pts[s as usize];
+                let sides = self.samples.sides[s as usize];
+                let near_new = |k: usize| {
+                    if self.sides[new_ids[k] as usize] == sides {
+                        within_d2(p, &new[k].1, tol, t2)
+                    } else {
+                        None
+                    }
+                };
+                let found = near_new(last).map(|d2| (last, d2)).or_else(|| {
+                    (0..new.len())
+                        .filter(|&k| k != last)
+                        .find_map(|k| near_new(k).map(|d2| (k, d2)))
+                });
+                if let Some((k, d2)) = found {
+                    last = k;
+                    plan.push((s, new_ids[k], d2.sqrt()));
+                    continue;
+                }
+                // The triangles that stay.
+                self.grid
+                    .query(p.map(|x| x - tol), p.map(|x| x + tol), &mut cand);
+                let kept = cand.iter().find_map(|&u| {
+                    if self.alive[u as usize]
+                        && !old.contains(&u)
+                        && self.sides[u as usize] == sides
+                    {
+                        within_d2(p, &self.corners(u), tol, t2).map(|d2| (u, d2))
+                    } else {
+                        None
+                    }
+                });
+                let (u, d2) = kept?;
+                plan.push((s, u, d2.sqrt()));
             }
         }
-        self.scratch2 = near;
-        ok
+        Some(plan)
+    }
+
+    /// Apply the covers of [`Self::recover_samples`].
+    fn apply_covers(&mut self, plan: &[(u32, u32, f64)]) {
+        for &(s, t, d) in plan {
+            let (was, _) = self.cover[s as usize];
+            if was != t {
+                let l = &mut self.covers[was as usize];
+                if let Some(i) = l.iter().position(|&x| x == s) {
+                    l.swap_remove(i);
+                }
+                self.covers[t as usize].push(s);
+            }
+            self.cover[s as usize] = (t, d);
+        }
     }
 
     /// Whether any of the proposed triangles `new` (corner ids and coordinates) meets another
     /// triangle other than in shared corners or a shared edge; triangles in `ignore` are about
     /// to go and are not tested.
-    fn crosses(&mut self, new: &[([u32; 3], [P3; 3])], ignore: &[u32]) -> bool {
+    fn crosses(&self, new: &[([u32; 3], [P3; 3])], ignore: &[u32]) -> bool {
+        let mut cand = Vec::new();
         for (i, (_, c)) in new.iter().enumerate() {
             for (_, d) in &new[..i] {
                 if !tri_tri(c, d).is_legal() {
@@ -322,9 +420,7 @@ impl<'a> Remesher<'a> {
                 }
             }
             let (lo, hi) = bbox(c);
-            let mut cand = std::mem::take(&mut self.scratch);
             self.grid.query(lo, hi, &mut cand);
-            let mut bad = false;
             for &u in &cand {
                 if !self.alive[u as usize] || ignore.contains(&u) {
                     continue;
@@ -335,13 +431,8 @@ impl<'a> Remesher<'a> {
                     continue;
                 }
                 if !tri_tri(c, &d).is_legal() {
-                    bad = true;
-                    break;
+                    return true;
                 }
-            }
-            self.scratch = cand;
-            if bad {
-                return true;
             }
         }
         false
@@ -358,7 +449,7 @@ impl<'a> Remesher<'a> {
             if dot(unit_normal(c), *n0) < 0.5 {
                 return false;
             }
-            if angles_deg(c).0 < floor {
+            if min_angle_deg(c) < floor {
                 return false;
             }
         }
@@ -367,7 +458,7 @@ impl<'a> Remesher<'a> {
 
     fn worst_angle(&self, ts: &[u32]) -> f64 {
         ts.iter()
-            .map(|&t| angles_deg(&self.corners(t)).0)
+            .map(|&t| min_angle_deg(&self.corners(t)))
             .fold(180.0, f64::min)
     }
 
@@ -380,6 +471,7 @@ impl<'a> Remesher<'a> {
             }
         }
         self.tris[t as usize] = tri;
+        self.dev[t as usize] = (f64::INFINITY, 0);
         for &v in &tri {
             self.vt[v as usize].push(t);
         }
@@ -403,6 +495,8 @@ impl<'a> Remesher<'a> {
         self.tris.push(tri);
         self.sides.push(sides);
         self.alive.push(true);
+        self.covers.push(Vec::new());
+        self.dev.push((f64::INFINITY, 0));
         for &v in &tri {
             self.vt[v as usize].push(t);
         }
@@ -460,19 +554,19 @@ impl<'a> Remesher<'a> {
         if !self.shape_ok(&new, &old_normals, floor) {
             return false;
         }
-        if !new
-            .iter()
-            .zip(&fan)
-            .all(|((_, c), &t)| self.near_input(c, self.sides[t as usize]))
-        {
+        let moved = dist2(x, self.pts[v as usize]).sqrt();
+        let Some(devs) = self.new_near_input(&new, &fan, Some((v, moved))) else {
             return false;
-        }
-        let old_c: Vec<[P3; 3]> = fan.iter().map(|&t| self.corners(t)).collect();
-        if !self.input_kept(&old_c, &new, &fan, self.sides[fan[0] as usize]) {
+        };
+        let Some(plan) = self.recover_samples(&fan, &new, &fan, moved) else {
             return false;
-        }
+        };
         if self.crosses(&new, &fan) {
             return false;
+        }
+        self.apply_covers(&plan);
+        for (&t, d) in fan.iter().zip(devs) {
+            self.dev[t as usize] = d;
         }
         for &t in &fan {
             self.grid.remove(t);
@@ -510,9 +604,27 @@ impl<'a> Remesher<'a> {
         self.size.push(self.target(a, b));
         let (s1, s2) = (self.sides[t1 as usize], self.sides[t2 as usize]);
         self.replace(t1, [a, mi, c]);
-        self.add([mi, b, c], s1);
+        let h1 = self.add([mi, b, c], s1);
         self.replace(t2, [b, mi, d]);
-        self.add([mi, a, d], s2);
+        let h2 = self.add([mi, a, d], s2);
+        // The halves cover what the two triangles covered: each sample goes to the nearer.
+        let mut plan = Vec::new();
+        for (t, h) in [(t1, h1), (t2, h2)] {
+            let (ct, ch) = (self.corners(t), self.corners(h));
+            for &s in &self.covers[t as usize] {
+                let p = self.samples.pts[s as usize];
+                let (dt, dh) = (
+                    dist2(p, closest_on_triangle(p, &ct)),
+                    dist2(p, closest_on_triangle(p, &ch)),
+                );
+                plan.push(if dh < dt {
+                    (s, h, dh.sqrt())
+                } else {
+                    (s, t, dt.sqrt())
+                });
+            }
+        }
+        self.apply_covers(&plan);
         self.counts.splits += 1;
         if let Some((x, h)) = self.project(mi, m)
             && self.try_move(mi, x)
@@ -573,25 +685,17 @@ impl<'a> Remesher<'a> {
         if !self.shape_ok(&new, &old_normals, floor) {
             return false;
         }
-        if !new
-            .iter()
-            .zip(&kept)
-            .all(|((_, c), &t)| self.near_input(c, self.sides[t as usize]))
-        {
+        let Some(devs) = self.new_near_input(&new, &kept, None) else {
             return false;
-        }
+        };
         // The removed point lay on (or near) the input: the new fan must pass near it.
         let t2r = self.tol * self.tol;
-        if !new
-            .iter()
-            .any(|(_, c)| dist2(pa, closest_on_triangle(pa, c)) <= t2r)
-        {
+        if !new.iter().any(|(_, c)| within(pa, c, self.tol, t2r)) {
             return false;
         }
-        let old_c: Vec<[P3; 3]> = fan.iter().map(|&t| self.corners(t)).collect();
-        if !self.input_kept(&old_c, &new, &fan, self.sides[t1 as usize]) {
+        let Some(plan) = self.recover_samples(&fan, &new, &kept, 0.0) else {
             return false;
-        }
+        };
         if self.crosses(&new, &fan) {
             return false;
         }
@@ -599,6 +703,10 @@ impl<'a> Remesher<'a> {
         self.kill(t2);
         for (&t, (tri, _)) in kept.iter().zip(&new) {
             self.replace(t, *tri);
+        }
+        self.apply_covers(&plan);
+        for (&t, d) in kept.iter().zip(devs) {
+            self.dev[t as usize] = d;
         }
         self.counts.collapses += 1;
         true
@@ -627,8 +735,8 @@ impl<'a> Remesher<'a> {
             ([d, b, c], [p(d), p(b), p(c)]),
         ];
         let old = [self.corners(t1), self.corners(t2)];
-        let old_min = angles_deg(&old[0]).0.min(angles_deg(&old[1]).0);
-        let new_min = angles_deg(&new[0].1).0.min(angles_deg(&new[1].1).0);
+        let old_min = min_angle_deg(&old[0]).min(min_angle_deg(&old[1]));
+        let new_min = min_angle_deg(&new[0].1).min(min_angle_deg(&new[1].1));
         if new_min <= old_min + 1e-9 {
             return false;
         }
@@ -646,18 +754,20 @@ impl<'a> Remesher<'a> {
         if dot(unit_normal(&new[0].1), unit_normal(&new[1].1)) < 0.5 {
             return false;
         }
-        let sides = self.sides[t1 as usize];
-        if !new.iter().all(|(_, c)| self.near_input(c, sides)) {
+        let Some(devs) = self.new_near_input(&new, &[t1, t2], None) else {
             return false;
-        }
-        if !self.input_kept(&old, &new, &[t1, t2], sides) {
+        };
+        let Some(plan) = self.recover_samples(&[t1, t2], &new, &[t1, t2], 0.0) else {
             return false;
-        }
+        };
         if self.crosses(&new, &[t1, t2]) {
             return false;
         }
         self.replace(t1, new[0].0);
         self.replace(t2, new[1].0);
+        self.apply_covers(&plan);
+        self.dev[t1 as usize] = devs[0];
+        self.dev[t2 as usize] = devs[1];
         self.counts.flips += 1;
         true
     }
@@ -786,12 +896,12 @@ impl<'a> Remesher<'a> {
         let hi = 4.0 / 3.0;
         let bad: Vec<u32> = (0..self.tris.len() as u32)
             .filter(|&t| {
-                self.alive[t as usize] && angles_deg(&self.corners(t)).0 < self.target_angle
+                self.alive[t as usize] && min_angle_deg(&self.corners(t)) < self.target_angle
             })
             .collect();
         let mut done = 0;
         for t in bad {
-            if !self.alive[t as usize] || angles_deg(&self.corners(t)).0 >= self.target_angle {
+            if !self.alive[t as usize] || min_angle_deg(&self.corners(t)) >= self.target_angle {
                 continue;
             }
             let tri = self.tris[t as usize];
@@ -850,5 +960,75 @@ impl<'a> Remesher<'a> {
     /// Number of triangles in the surface.
     pub fn n_alive(&self) -> usize {
         self.alive.iter().filter(|&&x| x).count()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{features, guard::InputSamples, median_edge_length, tests::uv_sphere};
+    use super::*;
+
+    /// The distance bounds the loop keeps instead of recomputing are true bounds: after rounds
+    /// of every operation on a needle sphere, every input sample is within the tolerance of the
+    /// triangle that covers it (by brute force, no farther than its bound), and every
+    /// triangle's samples are no farther from the input than its bound.
+    #[test]
+    fn the_kept_distance_bounds_hold() {
+        let s = uv_sphere(1.0, [0.0; 3], 24, 10);
+        let l = 0.6 * median_edge_length(&s);
+        let d: f64 = 0.02;
+        let f = features::find(&s, 30.0);
+        let index = PatchIndex::new(&s.points, &s.triangles, &s.sides, None);
+        let samples = InputSamples::new(&s, d.max(l / 4.0));
+        let size = vec![l; s.points.len()];
+        let tri_size = vec![l; s.triangles.len()];
+        let mut r = Remesher::new(&s, &f, &index, &samples, &size, &tri_size, l, 0.7 * d);
+        r.spacing = (0.25 * l).max(d);
+        for _ in 0..4 {
+            r.round();
+        }
+        r.clean_up();
+        let c = r.counts;
+        assert!(
+            c.splits > 0 && c.collapses > 0 && c.flips > 0 && c.moves > 0,
+            "{c:?}"
+        );
+        let slack = 1e-12;
+        for (i, &(t, b)) in r.cover.iter().enumerate() {
+            assert!(r.alive[t as usize], "sample {i} covered by a dead triangle");
+            assert!(r.covers[t as usize].contains(&(i as u32)));
+            let p = samples.pts[i];
+            let dist = dist2(p, closest_on_triangle(p, &r.corners(t))).sqrt();
+            assert!(
+                dist <= b + slack && b <= r.tol + slack,
+                "sample {i}: {dist} {b}"
+            );
+        }
+        let input: Vec<[P3; 3]> = (0..s.n_triangles()).map(|t| s.corners(t)).collect();
+        let mut checked = 0;
+        for t in 0..r.tris.len() {
+            let (b, n) = r.dev[t];
+            if !r.alive[t] || n == 0 {
+                continue;
+            }
+            let c = r.corners(t as u32);
+            assert_eq!(n, r.sample_count(&c));
+            let n = n as usize;
+            for i in 0..=n {
+                for j in 0..=n - i {
+                    let k = n - i - j;
+                    let w = [i, j, k].map(|x| x as f64 / n as f64);
+                    let p = [0, 1, 2].map(|a| w[0] * c[0][a] + w[1] * c[1][a] + w[2] * c[2][a]);
+                    let dist = input
+                        .iter()
+                        .map(|u| dist2(p, closest_on_triangle(p, u)))
+                        .fold(f64::INFINITY, f64::min)
+                        .sqrt();
+                    assert!(dist <= b + slack, "triangle {t}: {dist} > {b}");
+                }
+            }
+            checked += 1;
+        }
+        assert!(checked > r.n_alive() / 2, "{checked} of {}", r.n_alive());
     }
 }
