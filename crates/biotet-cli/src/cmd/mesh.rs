@@ -222,7 +222,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
         None => (surface, None),
         Some(d) => {
             stage.set("improving the surface");
-            let (s, r) = super::surface::stage(&surface, d, a.size, &a.surface_stage)
+            let (s, r) = super::surface::stage(&surface, d, a.size, &a.surface_stage, &stage)
                 .with_context(|| name.clone())?;
             if let Some(path) = &a.surface_output {
                 biotet_io::write_surface(path, &s)?;

@@ -4,7 +4,7 @@
 use crate::{Common, progress::Stage};
 use anyhow::{Context, Result};
 use biotet::SurfaceMesh;
-use biotet::surface::{SurfaceOptions, SurfaceReport, improve};
+use biotet::surface::{SurfaceOptions, SurfaceReport, improve_with_progress};
 use serde_json::json;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -123,6 +123,7 @@ pub fn stage(
     tolerance: f64,
     edge_length: Option<f64>,
     s: &StageArgs,
+    progress: &Stage,
 ) -> Result<(SurfaceMesh, SurfaceReport)> {
     let opts = SurfaceOptions {
         tolerance,
@@ -132,7 +133,9 @@ pub fn stage(
         adaptive: s.adaptive_size,
         ..Default::default()
     };
-    Ok(improve(surface, &opts)?)
+    Ok(improve_with_progress(surface, &opts, &|step| {
+        progress.set(format!("improving the surface: {step}"))
+    })?)
 }
 
 /// The report as text lines.
@@ -188,8 +191,8 @@ fn run_improve(a: ImproveArgs) -> Result<ExitCode> {
     let (surface, _, name) =
         super::input::labelled_surface(&a.surfaces, &a.label, a.common, &stage_)?;
     stage_.set("improving the surface");
-    let (out, report) =
-        stage(&surface, a.tolerance, a.edge_length, &a.stage).with_context(|| name.clone())?;
+    let (out, report) = stage(&surface, a.tolerance, a.edge_length, &a.stage, &stage_)
+        .with_context(|| name.clone())?;
     if let Some(path) = &a.output {
         stage_.set(format!("writing {}", path.display()));
         biotet_io::write_surface(path, &out)?;

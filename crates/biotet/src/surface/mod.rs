@@ -244,6 +244,16 @@ pub fn improve(
     surface: &SurfaceMesh,
     opts: &SurfaceOptions,
 ) -> Result<(SurfaceMesh, SurfaceReport), SurfaceError> {
+    improve_with_progress(surface, opts, &|_| {})
+}
+
+/// [`improve`], telling `progress` which step it is in (`"round 2 of 6"`, `"clean-up"`,
+/// `"repair"`, `"validating"`, `"measuring"`): a label image's surface takes minutes.
+pub fn improve_with_progress(
+    surface: &SurfaceMesh,
+    opts: &SurfaceOptions,
+    progress: &dyn Fn(&str),
+) -> Result<(SurfaceMesh, SurfaceReport), SurfaceError> {
     let clock = Instant::now();
     let d = opts.tolerance;
     if !(d.is_finite() && d > 0.0) {
@@ -300,9 +310,11 @@ pub fn improve(
     r.spacing = (0.25 * l).max(d);
     r.target_angle = opts.target_angle_deg;
     r.open_necks();
-    for _ in 0..opts.rounds {
+    for k in 0..opts.rounds {
+        progress(&format!("round {} of {}", k + 1, opts.rounds));
         r.round();
     }
+    progress("clean-up");
     r.open_necks();
     // The clean-up may use a little more of the tolerance (the final measure has room).
     r.tol = 0.8 * d;
@@ -318,6 +330,7 @@ pub fn improve(
     let work_spacing = spacing;
     r.repairing = true;
     let mut last_far = usize::MAX;
+    progress("repair");
     for _ in 0..10 {
         let out_index = PatchIndex::new(&r.pts, &r.tris, &r.sides, Some(&r.alive));
         let oi = hausdorff::one_sided(
@@ -362,6 +375,7 @@ pub fn improve(
             r.refine_triangle(t);
         }
     }
+    progress("validating");
     let mut out = r.to_surface();
     validate_surface(
         &mut out,
@@ -373,6 +387,7 @@ pub fn improve(
     .map_err(SurfaceError::Output)?;
 
     // The final measure, on the output as returned.
+    progress("measuring");
     let out_index = PatchIndex::new(&out.points, &out.triangles, &out.sides, None);
     let measure = |floor: f64| {
         let oi = hausdorff::one_sided(

@@ -191,3 +191,30 @@ fn a_tolerance_too_small_to_move_fails_clearly_or_keeps_it() {
     assert!(r.hausdorff_in_to_out <= d && r.hausdorff_out_to_in <= d);
     assert!(brute_one_sided(&out, &input, 1) <= d);
 }
+
+/// The steps reported to the progress hook come in order, and watching changes nothing.
+#[test]
+fn progress_names_each_step_in_order() {
+    let input = uv_sphere(1.0, [0.0; 3], 24, 10);
+    let opts = SurfaceOptions {
+        tolerance: 0.02,
+        rounds: 3,
+        ..Default::default()
+    };
+    let log = std::cell::RefCell::new(Vec::new());
+    let (watched, _) =
+        improve_with_progress(&input, &opts, &|m| log.borrow_mut().push(m.to_string()))
+            .expect("improves");
+    let (plain, _) = improve(&input, &opts).expect("improves");
+    assert_eq!(watched, plain);
+    let want = [
+        "round 1 of 3",
+        "round 2 of 3",
+        "round 3 of 3",
+        "clean-up",
+        "repair",
+        "validating",
+        "measuring",
+    ];
+    assert_eq!(*log.borrow(), want);
+}
