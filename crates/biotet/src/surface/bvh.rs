@@ -55,6 +55,33 @@ impl Hint {
     }
 }
 
+/// The nodes still to visit in a depth-first descent: a median split keeps the tree's depth
+/// under 64 for any `u32` count, and a descent holds at most the depth plus one, so a fixed
+/// array serves without allocating.
+struct NodeStack {
+    nodes: [u32; 64],
+    len: usize,
+}
+
+impl NodeStack {
+    fn root() -> NodeStack {
+        NodeStack {
+            nodes: [0; 64],
+            len: 1,
+        }
+    }
+
+    fn push(&mut self, i: u32) {
+        self.nodes[self.len] = i;
+        self.len += 1;
+    }
+
+    fn pop(&mut self) -> Option<u32> {
+        self.len = self.len.checked_sub(1)?;
+        Some(self.nodes[self.len])
+    }
+}
+
 /// A bounding-volume hierarchy over triangles, for closest-point queries.
 #[derive(Debug, Clone)]
 pub struct Bvh {
@@ -234,8 +261,7 @@ impl Bvh {
             point: p,
             triangle: u32::MAX,
         };
-        let mut stack: Vec<u32> = Vec::with_capacity(64);
-        stack.push(0);
+        let mut stack = NodeStack::root();
         while let Some(i) = stack.pop() {
             let node = &self.nodes[i as usize];
             if box_d2(p, node.lo, node.hi) >= best.d2 {
@@ -262,7 +288,7 @@ impl Bvh {
 
     /// Push the children of inner node `i` (left `i + 1`, right `r`), the nearer to `p` last so
     /// that it is popped first.
-    fn push_children(&self, p: P3, i: u32, r: u32, stack: &mut Vec<u32>) {
+    fn push_children(&self, p: P3, i: u32, r: u32, stack: &mut NodeStack) {
         let l = i + 1;
         let dl = box_d2(p, self.nodes[l as usize].lo, self.nodes[l as usize].hi);
         let dr = box_d2(p, self.nodes[r as usize].lo, self.nodes[r as usize].hi);
@@ -305,12 +331,8 @@ impl Bvh {
                 return Some(d2);
             }
         }
-        // Depth first, so the stack never holds more than the tree's depth plus one.
-        let mut stack = [0u32; 128];
-        let mut top = 1;
-        while top > 0 {
-            top -= 1;
-            let i = stack[top];
+        let mut stack = NodeStack::root();
+        while let Some(i) = stack.pop() {
             let node = &self.nodes[i as usize];
             if box_d2(p, node.lo, node.hi) > r2 {
                 continue;
@@ -323,13 +345,7 @@ impl Bvh {
                     }
                 }
             } else {
-                let (l, rr) = (i + 1, node.start);
-                let dl = box_d2(p, self.nodes[l as usize].lo, self.nodes[l as usize].hi);
-                let dr = box_d2(p, self.nodes[rr as usize].lo, self.nodes[rr as usize].hi);
-                let (first, second) = if dl <= dr { (rr, l) } else { (l, rr) };
-                stack[top] = first;
-                stack[top + 1] = second;
-                top += 2;
+                self.push_children(p, i, node.start, &mut stack);
             }
         }
         None
