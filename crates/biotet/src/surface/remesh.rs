@@ -109,6 +109,14 @@ pub struct Remesher<'a> {
     /// Per triangle: an upper bound on the distance of its samples to the input, and their
     /// number per edge (0: unknown).
     dev: Vec<(f64, u8)>,
+    /// A clock that ticks at every change below.
+    clock: u64,
+    /// Per triangle: the tick of its last change (its corners, or one of them moved).
+    changed: Vec<u64>,
+    /// Per triangle and edge `k` (`tri[k]`, `tri[k + 1]`): the tick at which [`Remesher::flip`]
+    /// found that flipping it raises no angle (0: never). That depends on the two triangles'
+    /// points alone, so while neither changed since, the answer stands without the angles.
+    no_flip: Vec<[u64; 3]>,
     tri_size: &'a [f64],
     /// Target edge length per point.
     pub size: Vec<f64>,
@@ -166,6 +174,9 @@ impl<'a> Remesher<'a> {
             cover: samples.tri.iter().map(|&t| (t, 0.0)).collect(),
             covers,
             dev: vec![(f64::INFINITY, 0); s.triangles.len()],
+            clock: 0,
+            changed: vec![0; s.triangles.len()],
+            no_flip: vec![[0; 3]; s.triangles.len()],
             tri_size,
             size: point_size.to_vec(),
             grid,
@@ -462,7 +473,14 @@ impl<'a> Remesher<'a> {
             .fold(180.0, f64::min)
     }
 
+    /// Note that triangle `t` changed.
+    fn touch(&mut self, t: u32) {
+        self.clock += 1;
+        self.changed[t as usize] = self.clock;
+    }
+
     fn replace(&mut self, t: u32, tri: [u32; 3]) {
+        self.touch(t);
         self.grid.remove(t);
         for &v in &self.tris[t as usize] {
             let l = &mut self.vt[v as usize];
@@ -480,6 +498,7 @@ impl<'a> Remesher<'a> {
     }
 
     fn kill(&mut self, t: u32) {
+        self.touch(t);
         self.grid.remove(t);
         for &v in &self.tris[t as usize] {
             let l = &mut self.vt[v as usize];
@@ -497,6 +516,9 @@ impl<'a> Remesher<'a> {
         self.alive.push(true);
         self.covers.push(Vec::new());
         self.dev.push((f64::INFINITY, 0));
+        self.changed.push(0);
+        self.no_flip.push([0; 3]);
+        self.touch(t);
         for &v in &tri {
             self.vt[v as usize].push(t);
         }
@@ -573,6 +595,7 @@ impl<'a> Remesher<'a> {
         }
         self.pts[v as usize] = x;
         for &t in &fan {
+            self.touch(t);
             let c = self.corners(t);
             self.grid.insert(t, &c);
         }
@@ -729,6 +752,14 @@ impl<'a> Remesher<'a> {
         {
             return false;
         }
+        let k1 = self.tris[t1 as usize]
+            .iter()
+            .position(|&x| x == a)
+            .unwrap_or(0);
+        if self.no_flip[t1 as usize][k1] > self.changed[t1 as usize].max(self.changed[t2 as usize])
+        {
+            return false;
+        }
         let p = |v: u32| self.pts[v as usize];
         let new = [
             ([c, a, d], [p(c), p(a), p(d)]),
@@ -738,6 +769,8 @@ impl<'a> Remesher<'a> {
         let old_min = min_angle_deg(&old[0]).min(min_angle_deg(&old[1]));
         let new_min = min_angle_deg(&new[0].1).min(min_angle_deg(&new[1].1));
         if new_min <= old_min + 1e-9 {
+            self.clock += 1;
+            self.no_flip[t1 as usize][k1] = self.clock;
             return false;
         }
         let n_old = {
@@ -1030,5 +1063,63 @@ mod tests {
             checked += 1;
         }
         assert!(checked > r.n_alive() / 2, "{checked} of {}", r.n_alive());
+    }
+
+    /// A flip refusal on record stands only while its two triangles are as they were: after the
+    /// points of a sphere are moved far (a loose tolerance lets them), every refusal still on
+    /// record is what the angles say now, and some refusals were dropped.
+    #[test]
+    fn a_recorded_flip_refusal_is_what_the_angles_say() {
+        let s = uv_sphere(1.0, [0.0; 3], 16, 8);
+        let l = median_edge_length(&s);
+        let d: f64 = 0.5;
+        let f = features::find(&s, 30.0);
+        let index = PatchIndex::new(&s.points, &s.triangles, &s.sides, None);
+        let samples = InputSamples::new(&s, d.max(l / 4.0));
+        let size = vec![l; s.points.len()];
+        let tri_size = vec![l; s.triangles.len()];
+        let mut r = Remesher::new(&s, &f, &index, &samples, &size, &tri_size, l, 0.7 * d);
+        r.flips();
+        let on_record = |r: &Remesher| {
+            let mut n = 0;
+            for t in 0..r.tris.len() as u32 {
+                let tri = r.tris[t as usize];
+                for k in 0..3 {
+                    let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                    let Some((t1, t2, c, d)) = r.edge_pair(a, b) else {
+                        continue;
+                    };
+                    assert_eq!(t1, t);
+                    let seen = r.no_flip[t as usize][k];
+                    if seen <= r.changed[t as usize].max(r.changed[t2 as usize]) {
+                        continue;
+                    }
+                    let p = |v: u32| r.pts[v as usize];
+                    let old = min_angle_deg(&r.corners(t1)).min(min_angle_deg(&r.corners(t2)));
+                    let new =
+                        min_angle_deg(&[p(c), p(a), p(d)]).min(min_angle_deg(&[p(d), p(b), p(c)]));
+                    assert!(new <= old + 1e-9, "edge {a} {b}: {old} -> {new}");
+                    n += 1;
+                }
+            }
+            n
+        };
+        let before = on_record(&r);
+        assert!(before > r.n_alive(), "{before} refusals on record");
+        // Move every third point a third of the way to a neighbour, back onto the sphere.
+        let mut moved = 0;
+        for v in (0..r.pts.len() as u32).step_by(3) {
+            let Some(&u) = r.neighbours(v).first() else {
+                continue;
+            };
+            let q = add(
+                r.pts[v as usize],
+                scale(sub(r.pts[u as usize], r.pts[v as usize]), 0.33),
+            );
+            moved += r.try_move(v, scale(q, 1.0 / norm(q))) as usize;
+        }
+        assert!(moved > 10, "{moved} moved");
+        let after = on_record(&r);
+        assert!(after < before, "{after} of {before} left");
     }
 }
