@@ -15,8 +15,10 @@
 //!    exceeds the working tolerance, the offending output triangle's longest edge is split and
 //!    the new point projected onto the input, until it does not (or a bounded number of rounds);
 //! 4. validation of the output ([`crate::mesh::validate::validate_surface`], with the exact
-//!    self-intersection test), and the final measure with dense samples; the run fails with
-//!    [`SurfaceError::Tolerance`] if the distance exceeds `D`.
+//!    self-intersection test), and the final measure with dense samples; where it finds the
+//!    output beyond `D` (between the repair's coarser samples) the triangles there are refined
+//!    as in the repair and the output validated and measured again (at most three times); the
+//!    run fails with [`SurfaceError::Tolerance`] if the distance still exceeds `D`.
 //!
 //! Everything is sequential except the measures (parallel, order-independent), so the output is
 //! the same on any number of threads.
@@ -375,59 +377,47 @@ pub fn improve_with_progress(
             r.refine_triangle(t);
         }
     }
-    progress("validating");
-    let mut out = r.to_surface();
-    validate_surface(
-        &mut out,
-        &ValidateOptions {
-            fix_inward: false,
-            ..Default::default()
-        },
-    )
-    .map_err(SurfaceError::Output)?;
-
-    // The final measure, on the output as returned.
-    progress("measuring");
-    let out_index = PatchIndex::new(&out.points, &out.triangles, &out.sides, None);
-    let measure = |floor: f64| {
-        let oi = hausdorff::one_sided(
-            &out.points,
-            &out.triangles,
-            &out.sides,
-            None,
-            &index,
-            spacing,
-            spacing / 32.0,
-            d,
-            f64::INFINITY,
-            floor,
-        );
-        let io = hausdorff::one_sided(
-            &surface.points,
-            &surface.triangles,
-            &surface.sides,
-            None,
-            &out_index,
-            spacing,
-            spacing / 32.0,
-            d,
-            f64::INFINITY,
-            floor,
-        );
-        (oi, io)
+    // Validate and measure; where the dense measure finds the output beyond D (between the
+    // repair's samples), refine there and measure again, a bounded number of times.
+    let mut final_repairs = 0;
+    let (out, oi, io) = loop {
+        progress("validating");
+        let mut out = r.to_surface();
+        validate_surface(
+            &mut out,
+            &ValidateOptions {
+                fix_inward: false,
+                ..Default::default()
+            },
+        )
+        .map_err(SurfaceError::Output)?;
+        progress("measuring");
+        let (oi, io) = final_measure(surface, &out, &index, spacing, d);
+        let beyond = oi.max > d || io.max > d;
+        if !beyond || final_repairs == FINAL_REPAIRS {
+            break (out, oi, io);
+        }
+        final_repairs += 1;
+        // `out` lists the alive triangles of `r` in order.
+        let ids: Vec<u32> = (0..r.tris.len() as u32)
+            .filter(|&t| r.alive[t as usize])
+            .collect();
+        if ids.len() != out.triangles.len() {
+            break (out, oi, io);
+        }
+        let mut targets: Vec<u32> = oi
+            .far
+            .iter()
+            .map(|x| ids[x.triangle as usize])
+            .chain(io.far.iter().map(|x| ids[x.nearest as usize]))
+            .collect();
+        targets.sort_unstable();
+        targets.dedup();
+        for t in targets {
+            r.refine_triangle(t);
+        }
+        repair_rounds += 1;
     };
-    // First with the samples under 0.4 D left unmeasured (then a triangle whose samples are all
-    // under it is proven within 0.4 D + D/√3 < D by its coarse samples alone); exactly if some
-    // sheet is below that.
-    let (mut oi, mut io) = measure(0.4 * d);
-    if oi
-        .per_sheet
-        .iter()
-        .chain(&io.per_sheet)
-        .any(|x| x.1 <= 0.4 * d)
-    {
-        (oi, io) = measure(0.0);
-    }
     if oi.max > d || io.max > d {
         return Err(SurfaceError::Tolerance {
             tolerance: d,
@@ -507,6 +497,63 @@ pub fn improve_with_progress(
         seconds: clock.elapsed().as_secs_f64(),
     };
     Ok((out, report))
+}
+
+/// How many times the final measure may send the stage back to refine where it finds the
+/// output beyond the tolerance.
+const FINAL_REPAIRS: usize = 3;
+
+/// The final measure of `out` against the input `surface` (both ways, dense samples, every
+/// triangle's bound refined until it proves the tolerance `d` or the samples reach a 32nd of
+/// `spacing`); samples beyond `d` are listed as far.
+fn final_measure(
+    surface: &SurfaceMesh,
+    out: &SurfaceMesh,
+    index: &PatchIndex,
+    spacing: f64,
+    d: f64,
+) -> (hausdorff::Sided, hausdorff::Sided) {
+    let out_index = PatchIndex::new(&out.points, &out.triangles, &out.sides, None);
+    let measure = |floor: f64| {
+        let oi = hausdorff::one_sided(
+            &out.points,
+            &out.triangles,
+            &out.sides,
+            None,
+            index,
+            spacing,
+            spacing / 32.0,
+            d,
+            d,
+            floor,
+        );
+        let io = hausdorff::one_sided(
+            &surface.points,
+            &surface.triangles,
+            &surface.sides,
+            None,
+            &out_index,
+            spacing,
+            spacing / 32.0,
+            d,
+            d,
+            floor,
+        );
+        (oi, io)
+    };
+    // First with the samples under 0.4 D left unmeasured (then a triangle whose samples are all
+    // under it is proven within 0.4 D + D/√3 < D by its coarse samples alone); exactly if some
+    // sheet is below that.
+    let (oi, io) = measure(0.4 * d);
+    if oi
+        .per_sheet
+        .iter()
+        .chain(&io.per_sheet)
+        .any(|x| x.1 <= 0.4 * d)
+    {
+        return measure(0.0);
+    }
+    (oi, io)
 }
 
 #[cfg(test)]

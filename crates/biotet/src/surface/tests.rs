@@ -218,3 +218,34 @@ fn progress_names_each_step_in_order() {
     ];
     assert_eq!(*log.borrow(), want);
 }
+
+/// The final measure lists, both ways, the triangles with a sample beyond the tolerance (what
+/// the stage refines before it gives up), and none when the surfaces are within it.
+#[test]
+fn the_final_measure_lists_what_lies_beyond_the_tolerance() {
+    let input = uv_sphere(1.0, [0.0; 3], 24, 12);
+    let mut out = input.clone();
+    // Push one point out by 0.05: the triangles around it stray that far.
+    out.points[40] = out.points[40].map(|x| x * 1.05);
+    let index = PatchIndex::new(&input.points, &input.triangles, &input.sides, None);
+    let (oi, io) = final_measure(&input, &out, &index, 0.01, 0.03);
+    assert!(
+        oi.max > 0.03 && !oi.far.is_empty(),
+        "{} {}",
+        oi.max,
+        oi.far.len()
+    );
+    for f in &oi.far {
+        assert!(f.distance > 0.03);
+        assert!(out.triangles[f.triangle as usize].contains(&40), "{f:?}");
+    }
+    // And the input's point there is as far from the bump.
+    assert!(io.max > 0.03 && !io.far.is_empty(), "{}", io.max);
+    for f in &io.far {
+        assert!(f.distance > 0.03);
+        assert!(out.triangles[f.nearest as usize].contains(&40), "{f:?}");
+    }
+    let (oi, io) = final_measure(&input, &out, &index, 0.01, 0.06);
+    assert!(oi.far.is_empty() && io.far.is_empty());
+    assert!(oi.max > 0.04 && oi.max <= 0.05 + 1e-12, "{}", oi.max);
+}
