@@ -334,30 +334,17 @@ pub fn improve_with_progress(
     let mut last_far = usize::MAX;
     progress("repair");
     for _ in 0..10 {
-        let out_index = PatchIndex::new(&r.pts, &r.tris, &r.sides, Some(&r.alive));
-        let oi = hausdorff::one_sided(
-            &r.pts,
-            &r.tris,
-            &r.sides,
-            Some(&r.alive),
+        let (oi, io) = both_ways(
+            surface,
             &index,
-            work_spacing,
-            work_spacing,
-            f64::INFINITY,
-            0.9 * d,
-            0.8 * d,
-        );
-        let io = hausdorff::one_sided(
-            &surface.points,
-            &surface.triangles,
-            &surface.sides,
-            None,
-            &out_index,
-            work_spacing,
-            work_spacing,
-            f64::INFINITY,
-            0.9 * d,
-            0.8 * d,
+            (&r.pts, &r.tris, &r.sides, Some(&r.alive)),
+            Sampling {
+                spacing: work_spacing,
+                fine: work_spacing,
+                limit: f64::INFINITY,
+                flag: 0.9 * d,
+                floor: 0.8 * d,
+            },
         );
         let n_far = oi.far.len() + io.far.len();
         if n_far == 0 || n_far >= last_far {
@@ -499,6 +486,49 @@ pub fn improve_with_progress(
     Ok((out, report))
 }
 
+/// How [`both_ways`] samples (see [`hausdorff::one_sided`]).
+struct Sampling {
+    spacing: f64,
+    fine: f64,
+    limit: f64,
+    flag: f64,
+    floor: f64,
+}
+
+/// An output surface as points, triangles, side labels and (optionally) which triangles are in.
+type OutSurface<'s> = (
+    &'s [[f64; 3]],
+    &'s [[u32; 3]],
+    &'s [[u32; 2]],
+    Option<&'s [bool]>,
+);
+
+/// The one-sided distances output → input (`index` over `input`) and input → output.
+fn both_ways(
+    input: &SurfaceMesh,
+    index: &PatchIndex,
+    (pts, tris, sides, alive): OutSurface<'_>,
+    s: Sampling,
+) -> (hausdorff::Sided, hausdorff::Sided) {
+    let out_index = PatchIndex::new(pts, tris, sides, alive);
+    let oi = hausdorff::one_sided(
+        pts, tris, sides, alive, index, s.spacing, s.fine, s.limit, s.flag, s.floor,
+    );
+    let io = hausdorff::one_sided(
+        &input.points,
+        &input.triangles,
+        &input.sides,
+        None,
+        &out_index,
+        s.spacing,
+        s.fine,
+        s.limit,
+        s.flag,
+        s.floor,
+    );
+    (oi, io)
+}
+
 /// How many times the final measure may send the stage back to refine where it finds the
 /// output beyond the tolerance.
 const FINAL_REPAIRS: usize = 3;
@@ -513,33 +543,19 @@ fn final_measure(
     spacing: f64,
     d: f64,
 ) -> (hausdorff::Sided, hausdorff::Sided) {
-    let out_index = PatchIndex::new(&out.points, &out.triangles, &out.sides, None);
     let measure = |floor: f64| {
-        let oi = hausdorff::one_sided(
-            &out.points,
-            &out.triangles,
-            &out.sides,
-            None,
+        both_ways(
+            surface,
             index,
-            spacing,
-            spacing / 32.0,
-            d,
-            d,
-            floor,
-        );
-        let io = hausdorff::one_sided(
-            &surface.points,
-            &surface.triangles,
-            &surface.sides,
-            None,
-            &out_index,
-            spacing,
-            spacing / 32.0,
-            d,
-            d,
-            floor,
-        );
-        (oi, io)
+            (&out.points, &out.triangles, &out.sides, None),
+            Sampling {
+                spacing,
+                fine: spacing / 32.0,
+                limit: d,
+                flag: d,
+                floor,
+            },
+        )
     };
     // First with the samples under 0.4 D left unmeasured (then a triangle whose samples are all
     // under it is proven within 0.4 D + D/√3 < D by its coarse samples alone); exactly if some
