@@ -334,10 +334,12 @@ pub fn improve_with_progress(
     let mut last_far = usize::MAX;
     progress("repair");
     for _ in 0..10 {
+        let out_index = PatchIndex::new(&r.pts, &r.tris, &r.sides, Some(&r.alive));
         let (oi, io) = both_ways(
             surface,
             &index,
             (&r.pts, &r.tris, &r.sides, Some(&r.alive)),
+            &out_index,
             Sampling {
                 spacing: work_spacing,
                 fine: work_spacing,
@@ -352,17 +354,7 @@ pub fn improve_with_progress(
         }
         last_far = last_far.min(n_far);
         repair_rounds += 1;
-        let mut targets: Vec<u32> = oi
-            .far
-            .iter()
-            .map(|x| x.triangle)
-            .chain(io.far.iter().map(|x| x.nearest))
-            .collect();
-        targets.sort_unstable();
-        targets.dedup();
-        for t in targets {
-            r.refine_triangle(t);
-        }
+        refine_where_far(&mut r, &oi, &io, |t| t);
     }
     // Validate and measure; where the dense measure finds the output beyond D (between the
     // repair's samples), refine there and measure again, a bounded number of times.
@@ -392,17 +384,7 @@ pub fn improve_with_progress(
         if ids.len() != out.triangles.len() {
             break (out, oi, io);
         }
-        let mut targets: Vec<u32> = oi
-            .far
-            .iter()
-            .map(|x| ids[x.triangle as usize])
-            .chain(io.far.iter().map(|x| ids[x.nearest as usize]))
-            .collect();
-        targets.sort_unstable();
-        targets.dedup();
-        for t in targets {
-            r.refine_triangle(t);
-        }
+        refine_where_far(&mut r, &oi, &io, |t| ids[t as usize]);
         repair_rounds += 1;
     };
     if oi.max > d || io.max > d {
@@ -503,14 +485,15 @@ type OutSurface<'s> = (
     Option<&'s [bool]>,
 );
 
-/// The one-sided distances output → input (`index` over `input`) and input → output.
+/// The one-sided distances output → input (`index` over `input`) and input → output
+/// (`out_index` over the output).
 fn both_ways(
     input: &SurfaceMesh,
     index: &PatchIndex,
     (pts, tris, sides, alive): OutSurface<'_>,
+    out_index: &PatchIndex,
     s: Sampling,
 ) -> (hausdorff::Sided, hausdorff::Sided) {
-    let out_index = PatchIndex::new(pts, tris, sides, alive);
     let oi = hausdorff::one_sided(
         pts, tris, sides, alive, index, s.spacing, s.fine, s.limit, s.flag, s.floor,
     );
@@ -519,7 +502,7 @@ fn both_ways(
         &input.triangles,
         &input.sides,
         None,
-        &out_index,
+        out_index,
         s.spacing,
         s.fine,
         s.limit,
@@ -527,6 +510,28 @@ fn both_ways(
         s.floor,
     );
     (oi, io)
+}
+
+/// Split and project where the measure found the output far: the output triangles of far
+/// samples and the output triangles nearest to far input samples (`id` maps a measured
+/// triangle to the remesher's), each once, in order.
+fn refine_where_far(
+    r: &mut remesh::Remesher,
+    oi: &hausdorff::Sided,
+    io: &hausdorff::Sided,
+    id: impl Fn(u32) -> u32,
+) {
+    let mut targets: Vec<u32> = oi
+        .far
+        .iter()
+        .map(|x| id(x.triangle))
+        .chain(io.far.iter().map(|x| id(x.nearest)))
+        .collect();
+    targets.sort_unstable();
+    targets.dedup();
+    for t in targets {
+        r.refine_triangle(t);
+    }
 }
 
 /// How many times the final measure may send the stage back to refine where it finds the
@@ -543,11 +548,13 @@ fn final_measure(
     spacing: f64,
     d: f64,
 ) -> (hausdorff::Sided, hausdorff::Sided) {
+    let out_index = PatchIndex::new(&out.points, &out.triangles, &out.sides, None);
     let measure = |floor: f64| {
         both_ways(
             surface,
             index,
             (&out.points, &out.triangles, &out.sides, None),
+            &out_index,
             Sampling {
                 spacing,
                 fine: spacing / 32.0,

@@ -1001,6 +1001,42 @@ mod tests {
     use super::super::{features, guard::InputSamples, median_edge_length, tests::uv_sphere};
     use super::*;
 
+    /// What a [`Remesher`] borrows, for surface `s` at tolerance `d` and edge length `l`, set
+    /// up as the stage does (samples spaced `max(d, l/4)`, uniform sizes, 0.7 D working
+    /// tolerance).
+    struct Fixture {
+        f: Features,
+        index: PatchIndex,
+        samples: InputSamples,
+        size: Vec<f64>,
+        tri_size: Vec<f64>,
+    }
+
+    impl Fixture {
+        fn new(s: &SurfaceMesh, d: f64, l: f64) -> Fixture {
+            Fixture {
+                f: features::find(s, 30.0),
+                index: PatchIndex::new(&s.points, &s.triangles, &s.sides, None),
+                samples: InputSamples::new(s, d.max(l / 4.0)),
+                size: vec![l; s.points.len()],
+                tri_size: vec![l; s.triangles.len()],
+            }
+        }
+
+        fn remesher<'a>(&'a self, s: &SurfaceMesh, d: f64, l: f64) -> Remesher<'a> {
+            Remesher::new(
+                s,
+                &self.f,
+                &self.index,
+                &self.samples,
+                &self.size,
+                &self.tri_size,
+                l,
+                0.7 * d,
+            )
+        }
+    }
+
     /// The distance bounds the loop keeps instead of recomputing are true bounds: after rounds
     /// of every operation on a needle sphere, every input sample is within the tolerance of the
     /// triangle that covers it (by brute force, no farther than its bound), and every
@@ -1010,12 +1046,9 @@ mod tests {
         let s = uv_sphere(1.0, [0.0; 3], 24, 10);
         let l = 0.6 * median_edge_length(&s);
         let d: f64 = 0.02;
-        let f = features::find(&s, 30.0);
-        let index = PatchIndex::new(&s.points, &s.triangles, &s.sides, None);
-        let samples = InputSamples::new(&s, d.max(l / 4.0));
-        let size = vec![l; s.points.len()];
-        let tri_size = vec![l; s.triangles.len()];
-        let mut r = Remesher::new(&s, &f, &index, &samples, &size, &tri_size, l, 0.7 * d);
+        let fx = Fixture::new(&s, d, l);
+        let mut r = fx.remesher(&s, d, l);
+        let samples = &fx.samples;
         r.spacing = (0.25 * l).max(d);
         for _ in 0..4 {
             r.round();
@@ -1073,12 +1106,8 @@ mod tests {
         let s = uv_sphere(1.0, [0.0; 3], 16, 8);
         let l = median_edge_length(&s);
         let d: f64 = 0.5;
-        let f = features::find(&s, 30.0);
-        let index = PatchIndex::new(&s.points, &s.triangles, &s.sides, None);
-        let samples = InputSamples::new(&s, d.max(l / 4.0));
-        let size = vec![l; s.points.len()];
-        let tri_size = vec![l; s.triangles.len()];
-        let mut r = Remesher::new(&s, &f, &index, &samples, &size, &tri_size, l, 0.7 * d);
+        let fx = Fixture::new(&s, d, l);
+        let mut r = fx.remesher(&s, d, l);
         r.flips();
         let on_record = |r: &Remesher| {
             let mut n = 0;
