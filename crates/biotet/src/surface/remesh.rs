@@ -614,13 +614,18 @@ impl<'a> Remesher<'a> {
         let (pa, pb) = (self.pts[a as usize], self.pts[b as usize]);
         let m = scale(add(pa, pb), 0.5);
         let (pc, pd) = (self.pts[c as usize], self.pts[d as usize]);
-        if [[pa, m, pc], [m, pb, pc], [pb, m, pd], [m, pa, pd]]
-            .iter()
-            .any(is_degenerate)
-        {
+        let halves = [[pa, m, pc], [m, pb, pc], [pb, m, pd], [m, pa, pd]];
+        if halves.iter().any(is_degenerate) {
             return false;
         }
+        // The rounded midpoint may lie off the edge: where another sheet passes that close,
+        // the halves can meet it though the two triangles did not.
         let mi = self.pts.len() as u32;
+        let ids = [[a, mi, c], [mi, b, c], [b, mi, d], [mi, a, d]];
+        let new: Vec<([u32; 3], [P3; 3])> = ids.into_iter().zip(halves).collect();
+        if self.crosses(&new, &[t1, t2]) {
+            return false;
+        }
         self.pts.push(m);
         self.vt.push(Vec::new());
         self.fixed.push(false);

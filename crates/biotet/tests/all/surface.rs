@@ -5,7 +5,7 @@ use biotet::mesh::validate::{ValidateOptions, validate_surface};
 use biotet::surface::{SurfaceOptions, improve};
 use rustc_hash::FxHashSet;
 
-use crate::common::load_stl;
+use crate::common::{load_shape, load_stl};
 
 /// The shortest edge of the thinnest neck: three points joined pairwise by edges that bound no
 /// triangle (the cross-section of a tube), `None` without necks.
@@ -81,4 +81,34 @@ fn thin_necks_of_a_marching_cubes_surface_are_opened() {
     assert_eq!(euler(&out), euler(&input));
     let after = thinnest_neck(&out).expect("the handles stay");
     assert!(after > d / 5.0, "thinnest neck {before} -> {after}");
+}
+
+#[test]
+fn a_hair_thin_torus_improves_within_a_tolerance_wider_than_its_tube() {
+    // trimesh's torus of radius 1 with a tube 0.002 across: at a tolerance of seven tube widths
+    // the two sides of the tube come within rounding of each other, and a split's rounded
+    // midpoint once folded one side through the other (an invalid output, refused).
+    let input = load_shape("tm_hair_torus.off");
+    let (lo, hi) = input
+        .points
+        .iter()
+        .fold(([f64::MAX; 3], [f64::MIN; 3]), |(lo, hi), p| {
+            (
+                [0, 1, 2].map(|k| lo[k].min(p[k])),
+                [0, 1, 2].map(|k| hi[k].max(p[k])),
+            )
+        });
+    let diag = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
+    let d = 0.005 * diag;
+    let (out, report) = improve(
+        &input,
+        &SurfaceOptions {
+            tolerance: d,
+            ..Default::default()
+        },
+    )
+    .expect("improves");
+    assert!(report.hausdorff_bound <= d, "{}", report.hausdorff_bound);
+    let mut check = out.clone();
+    validate_surface(&mut check, &ValidateOptions::default()).expect("valid output");
 }
