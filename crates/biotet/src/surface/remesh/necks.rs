@@ -3,11 +3,12 @@
 //! as marching cubes leaves along a voxel edge where two voxels touch diagonally), and its
 //! cross-section is that 3-cycle. No edge of it can collapse (the surface would pinch; the link
 //! condition refuses), so the tube's wall triangles keep an angle near zero. Opening the neck —
-//! moving its points apart, away from the cycle's centroid, within the working tolerance — keeps
-//! the shell's genus and gives the walls a usable width.
+//! spreading its points around the tube's axis, within the working tolerance — keeps the shell's
+//! genus and gives the walls a usable width.
 
+use super::dist2;
 use super::{P3, Remesher};
-use crate::geom::vec3::{add, dot, scale, sub};
+use crate::geom::vec3::{add, cross, dot, norm, scale, sub};
 
 impl Remesher<'_> {
     /// The necks whose edges are all shorter than `width`: sorted corner triples, each once.
@@ -41,36 +42,89 @@ impl Remesher<'_> {
         out
     }
 
-    /// Open the necks narrower than the working tolerance (every edge of the cycle shorter): each
-    /// free corner is moved away from the cycle's centroid so that its distance to it becomes
-    /// `tol` (the move at most `0.9 tol`, halved while the guards of [`Remesher::try_move`]
-    /// refuse it). Wider necks are left: they are the surface's own shape. Returns the points
-    /// moved.
+    /// The apex of the triangle that has the directed edge `u → v`.
+    fn apex(&self, u: u32, v: u32) -> Option<u32> {
+        self.vt[u as usize].iter().find_map(|&t| {
+            let tri = self.tris[t as usize];
+            let k = tri.iter().position(|&x| x == u)?;
+            (tri[(k + 1) % 3] == v).then_some(tri[(k + 2) % 3])
+        })
+    }
+
+    /// The direction of the tube through neck `n`: the triangles on the left of the directed
+    /// cycle `n0 → n1 → n2` all lie towards one end of the tube and those on the right towards
+    /// the other, so the sum of left apex minus right apex over the three edges runs along it.
+    fn neck_axis(&self, n: [u32; 3]) -> Option<P3> {
+        let mut w = [0.0; 3];
+        for k in 0..3 {
+            let (u, v) = (n[k], n[(k + 1) % 3]);
+            let (x, y) = (self.apex(u, v)?, self.apex(v, u)?);
+            w = add(w, sub(self.pts[x as usize], self.pts[y as usize]));
+        }
+        let l = norm(w);
+        (l > 0.0).then(|| scale(w, 1.0 / l))
+    }
+
+    /// Open the necks narrower than the working tolerance (every edge of the cycle shorter): the
+    /// cycle's corners are placed on the circle of radius `tol` around its centroid, in the
+    /// plane across the tube, 120° apart (the corner farthest from the tube's axis keeps its
+    /// direction), each move at most `0.9 tol` and halved while the guards of
+    /// [`Remesher::try_move`] refuse it. Moving away from the centroid alone would stretch a
+    /// cycle that lies along the tube (a needle of a cross-section) further along it. Wider
+    /// necks are left: they are the surface's own shape. Returns the points moved.
     pub fn open_necks(&mut self) -> usize {
         let mut moved = 0;
         for n in self.necks(self.tol) {
-            let g: P3 = scale(
+            let p = n.map(|v| self.pts[v as usize]);
+            let g: P3 = scale(add(add(p[0], p[1]), p[2]), 1.0 / 3.0);
+            let Some(w) = self.neck_axis(n) else {
+                continue;
+            };
+            // The corners' offsets across the tube.
+            let q = p.map(|x| {
+                let u = sub(x, g);
+                sub(u, scale(w, dot(u, w)))
+            });
+            let k0 = (0..3)
+                .max_by(|&i, &j| dot(q[i], q[i]).total_cmp(&dot(q[j], q[j])))
+                .unwrap_or(0);
+            let r0 = norm(q[k0]);
+            if r0 == 0.0 {
+                continue;
+            }
+            let d0 = scale(q[k0], 1.0 / r0);
+            let e = cross(w, d0);
+            let at = |deg: f64| {
+                let a = deg.to_radians();
                 add(
-                    add(self.pts[n[0] as usize], self.pts[n[1] as usize]),
-                    self.pts[n[2] as usize],
-                ),
-                1.0 / 3.0,
-            );
-            for v in n {
-                let p = self.pts[v as usize];
-                let u = sub(p, g);
-                let r = dot(u, u).sqrt();
-                if r == 0.0 || r >= self.tol {
+                    g,
+                    scale(add(scale(d0, a.cos()), scale(e, a.sin())), self.tol),
+                )
+            };
+            let (k1, k2) = ((k0 + 1) % 3, (k0 + 2) % 3);
+            // The two others take 120° and 240° in the order that moves them least.
+            let (a1, a2) = if dist2(p[k1], at(120.0)) + dist2(p[k2], at(240.0))
+                <= dist2(p[k1], at(240.0)) + dist2(p[k2], at(120.0))
+            {
+                (120.0, 240.0)
+            } else {
+                (240.0, 120.0)
+            };
+            for (k, target) in [(k0, at(0.0)), (k1, at(a1)), (k2, at(a2))] {
+                let v = n[k];
+                let x0 = self.pts[v as usize];
+                let step = sub(target, x0);
+                let len = norm(step);
+                if len == 0.0 {
                     continue;
                 }
-                let mut step = (self.tol - r).min(0.9 * self.tol);
+                let mut s = (0.9 * self.tol / len).min(1.0);
                 for _ in 0..3 {
-                    let x = add(p, scale(u, step / r));
-                    if self.try_move(v, x) {
+                    if self.try_move(v, add(x0, scale(step, s))) {
                         moved += 1;
                         break;
                     }
-                    step *= 0.5;
+                    s *= 0.5;
                 }
             }
         }
