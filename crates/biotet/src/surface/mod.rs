@@ -315,6 +315,8 @@ pub fn improve_with_progress(
     for k in 0..opts.rounds {
         progress(&format!("round {} of {}", k + 1, opts.rounds));
         r.round();
+        // The rounds make necks as they collapse; open each as it appears.
+        r.open_necks();
     }
     progress("clean-up");
     r.open_necks();

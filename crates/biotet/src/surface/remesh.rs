@@ -24,7 +24,7 @@
 //! The loop is sequential and visits edges and points in index order, so its output depends on
 //! the input alone.
 
-use rustc_hash::FxHashSet;
+use rustc_hash::{FxHashMap, FxHashSet};
 
 use super::bvh::{Hint, PatchIndex, closest_on_triangle, dist2, unit_normal, within, within_d2};
 use super::features::{Features, key};
@@ -133,6 +133,9 @@ pub struct Remesher<'a> {
     pub counts: OpCounts,
     /// Repair mode: a projection may lower the smallest angle (the distance comes first).
     pub repairing: bool,
+    /// The tubes of the necks opened so far ([`necks`]), and a hash of them by place.
+    tubes: Vec<necks::Tube>,
+    tube_cells: FxHashMap<[i32; 3], Vec<u32>>,
 }
 
 impl<'a> Remesher<'a> {
@@ -186,6 +189,8 @@ impl<'a> Remesher<'a> {
             target_angle: 30.0,
             counts: OpCounts::default(),
             repairing: false,
+            tubes: Vec::new(),
+            tube_cells: FxHashMap::default(),
         }
     }
 
@@ -533,12 +538,16 @@ impl<'a> Remesher<'a> {
         let t = *self.vt[v as usize].first()?;
         let bvh = self.input.get(self.sides[t as usize])?;
         let q = bvh.closest(p)?;
-        Some((q.point, self.tri_size[q.triangle as usize]))
+        Some((self.lift(p, q.point), self.tri_size[q.triangle as usize]))
     }
 
     /// The target length of edge `ab`.
     fn target(&self, a: u32, b: u32) -> f64 {
-        self.size[a as usize].min(self.size[b as usize])
+        let t = self.size[a as usize].min(self.size[b as usize]);
+        if self.tubes.is_empty() {
+            return t;
+        }
+        t.min(self.tube_size(scale(add(self.pts[a as usize], self.pts[b as usize]), 0.5)))
     }
 
     fn vertex_normal(&self, v: u32) -> P3 {

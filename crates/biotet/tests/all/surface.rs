@@ -101,6 +101,8 @@ fn thin_necks_of_a_marching_cubes_surface_are_opened() {
     assert!(after > d / 5.0, "thinnest neck {before} -> {after}");
     // Opened across the tube, not along it: two necks there were needles of cross-sections
     // lying along their tubes (0.27, 0.27 and 0.53 mm, 166°), and the tets inside were wedges.
+    // And cut into rings along the tube: the walls within 4 D of a neck were needles of 6°
+    // (a 0.6 mm neck, 4 mm walls).
     for n in necks(&out) {
         let (edges, largest) = neck_shape(&out, n);
         if edges.iter().all(|&e| e < 2.0 * d) {
@@ -108,8 +110,34 @@ fn thin_necks_of_a_marching_cubes_surface_are_opened() {
                 largest < 120.0,
                 "neck {n:?}: edges {edges:?}, largest angle {largest}"
             );
+            let worst = smallest_angle_near(&out, n, 4.0 * d);
+            assert!(worst > 12.0, "neck {n:?}: a wall triangle of {worst}°");
         }
     }
+}
+
+/// The smallest angle (degrees) of the triangles whose centroids lie within `r` of neck `n`'s.
+fn smallest_angle_near(s: &SurfaceMesh, n: [u32; 3], r: f64) -> f64 {
+    let centroid = |c: [[f64; 3]; 3]| [0, 1, 2].map(|k| (c[0][k] + c[1][k] + c[2][k]) / 3.0);
+    let g = centroid(n.map(|v| s.points[v as usize]));
+    let mut worst = 180.0f64;
+    for t in 0..s.triangles.len() {
+        let c = s.corners(t);
+        let m = centroid(c);
+        if (0..3).map(|k| (m[k] - g[k]).powi(2)).sum::<f64>() > r * r {
+            continue;
+        }
+        for k in 0..3 {
+            let (p, a, b) = (c[k], c[(k + 1) % 3], c[(k + 2) % 3]);
+            let u = [0, 1, 2].map(|i| a[i] - p[i]);
+            let v = [0, 1, 2].map(|i| b[i] - p[i]);
+            let dot = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+            let nu = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
+            let nv = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            worst = worst.min((dot / (nu * nv)).clamp(-1.0, 1.0).acos().to_degrees());
+        }
+    }
+    worst
 }
 
 #[test]

@@ -5,12 +5,98 @@
 //! condition refuses), so the tube's wall triangles keep an angle near zero. Opening the neck —
 //! spreading its points around the tube's axis, within the working tolerance — keeps the shell's
 //! genus and gives the walls a usable width.
+//!
+//! An opened neck is remembered as a *tube* (its centroid, axis and radius). The tube's walls are
+//! as long as the voxel edge (4 mm on wm_20k) against its 0.6 mm width, so they are needles and
+//! the tets inside wedges. Near a tube the target edge length is capped (four radii, growing by
+//! half the distance), so the rounds cut the walls into rings; and a point projected onto the
+//! input inside the tube's radius is lifted to it, across the axis in the direction of the point
+//! it came from, since the input there is a flat fin of the voxel face and the rings' points
+//! would otherwise fall back onto it and flatten the tube again.
 
 use super::dist2;
 use super::{P3, Remesher};
 use crate::geom::vec3::{add, cross, dot, norm, scale, sub};
 
+/// An opened neck's tube.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Tube {
+    /// The neck's centroid.
+    g: P3,
+    /// The tube's axis (unit).
+    w: P3,
+    /// The neck's mean distance from the axis.
+    rho: f64,
+}
+
+/// The edge-length cap near a tube: this many radii at the neck...
+const TUBE_SIZE: f64 = 4.0;
+/// ...growing by this much per unit of distance beyond the radius.
+const TUBE_GRADING: f64 = 0.5;
+
 impl Remesher<'_> {
+    /// The cell of `p` in the tubes' hash: cubes of twice the target edge length plus the
+    /// tolerance, beyond which a tube's cap exceeds every target and its lift does not reach.
+    fn tube_cell(&self, p: P3) -> [i32; 3] {
+        p.map(|x| (x / (2.0 * (self.l + self.tol))).floor() as i32)
+    }
+
+    /// The tubes whose reach may include `p`.
+    fn tubes_near(&self, p: P3) -> &[u32] {
+        self.tube_cells
+            .get(&self.tube_cell(p))
+            .map_or(&[], |v| v.as_slice())
+    }
+
+    /// Remember a tube (listed in every cell next to its own).
+    fn add_tube(&mut self, t: Tube) {
+        let id = self.tubes.len() as u32;
+        let c = self.tube_cell(t.g);
+        for i in -1..=1 {
+            for j in -1..=1 {
+                for k in -1..=1 {
+                    self.tube_cells
+                        .entry([c[0] + i, c[1] + j, c[2] + k])
+                        .or_default()
+                        .push(id);
+                }
+            }
+        }
+        self.tubes.push(t);
+    }
+
+    /// The cap on the target edge length at `p` from the tubes (infinite far from them).
+    pub(super) fn tube_size(&self, p: P3) -> f64 {
+        self.tubes_near(p)
+            .iter()
+            .map(|&i| {
+                let t = &self.tubes[i as usize];
+                TUBE_SIZE * t.rho + TUBE_GRADING * (dist2(p, t.g).sqrt() - t.rho).max(0.0)
+            })
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// Input point `q` for the output point near `p`: within a tube's reach (one target edge
+    /// length along it) and inside its radius, moved out to the radius in the direction of `p`
+    /// around the axis; elsewhere `q` itself.
+    pub(super) fn lift(&self, p: P3, q: P3) -> P3 {
+        for &i in self.tubes_near(q) {
+            let t = &self.tubes[i as usize];
+            let u = sub(q, t.g);
+            let a = dot(u, t.w);
+            if a.abs() > self.l || norm(sub(u, scale(t.w, a))) >= t.rho {
+                continue;
+            }
+            let up = sub(p, t.g);
+            let across = sub(up, scale(t.w, dot(up, t.w)));
+            let r = norm(across);
+            if r > 0.0 {
+                return add(add(t.g, scale(t.w, a)), scale(across, t.rho / r));
+            }
+        }
+        q
+    }
+
     /// The necks whose edges are all shorter than `width`: sorted corner triples, each once.
     fn necks(&self, width: f64) -> Vec<[u32; 3]> {
         let mut out = Vec::new();
@@ -126,6 +212,23 @@ impl Remesher<'_> {
                     }
                     s *= 0.5;
                 }
+            }
+            let rho = n
+                .iter()
+                .map(|&v| {
+                    let u = sub(self.pts[v as usize], g);
+                    norm(sub(u, scale(w, dot(u, w))))
+                })
+                .sum::<f64>()
+                / 3.0;
+            let known = self.tubes_near(g).iter().any(|&i| {
+                let t = &self.tubes[i as usize];
+                dist2(t.g, g) < t.rho * t.rho
+            });
+            // A neck the guards kept narrow is not a tube to ring: its cap would be a fraction of
+            // the tolerance (a hair-thin torus would be cut into thousands of rings).
+            if rho >= 0.5 * self.tol && !known {
+                self.add_tube(Tube { g, w, rho });
             }
         }
         moved
