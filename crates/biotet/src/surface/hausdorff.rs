@@ -39,14 +39,16 @@ pub struct Sided {
     pub bound: f64,
     /// Per side-label pair, the largest sampled distance.
     pub per_sheet: Vec<([u32; 2], f64)>,
-    /// The farthest sample of each triangle farther than the flag distance.
+    /// The farthest sample of each triangle farther than the flag distance or whose bound stays
+    /// over the limit.
     pub far: Vec<Far>,
     /// Number of samples measured.
     pub n_samples: usize,
 }
 
 /// The one-sided distance from the triangles `tris` over `pts` (those with `alive[t]`, when
-/// given) to `to`. Triangles farther than `flag` are listed in [`Sided::far`]. A triangle whose
+/// given) to `to`. Triangles farther than `flag`, or whose bound stays over `limit`, are listed
+/// in [`Sided::far`] (their farthest sample). A triangle whose
 /// bound (sampled maximum plus covering radius) exceeds `limit` is sampled again with spacing
 /// `fine` (pass `limit = f64::INFINITY` for one pass). Samples proven (by the Lipschitz bound
 /// from the previous sample of their row) no farther than `floor` or than the maximum so far are
@@ -129,14 +131,12 @@ pub fn one_sided(
                         prev = Some((p, d));
                         if d > max {
                             max = d;
-                            if d > flag {
-                                far = Some(Far {
-                                    triangle: t as u32,
-                                    point: p,
-                                    distance: d,
-                                    nearest: q.triangle,
-                                });
-                            }
+                            far = Some(Far {
+                                triangle: t as u32,
+                                point: p,
+                                distance: d,
+                                nearest: q.triangle,
+                            });
                         }
                     }
                 }
@@ -148,10 +148,14 @@ pub fn one_sided(
                 }
                 break;
             }
+            let step = longest / n as f64;
+            // Listed when farther than the flag, or when the finest samples cannot prove the
+            // limit (the bound is then over it though every sample is within).
+            let listed = max > flag || max + step / 3f64.sqrt() > limit;
             Per {
                 max,
-                step: longest / n as f64,
-                far,
+                step,
+                far: far.filter(|_| listed),
                 n: count,
             }
         })

@@ -374,7 +374,8 @@ pub fn improve_with_progress(
         .map_err(SurfaceError::Output)?;
         progress("measuring");
         let (oi, io) = final_measure(surface, &out, &index, spacing, d);
-        let beyond = oi.max > d || io.max > d;
+        // Beyond: a sample over D, or a bound the finest samples cannot bring under it.
+        let beyond = oi.bound.max(io.bound) > d;
         if !beyond || final_repairs == FINAL_REPAIRS {
             break (out, oi, io);
         }

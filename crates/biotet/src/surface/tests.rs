@@ -248,4 +248,14 @@ fn the_final_measure_lists_what_lies_beyond_the_tolerance() {
     let (oi, io) = final_measure(&input, &out, &index, 0.01, 0.06);
     assert!(oi.far.is_empty() && io.far.is_empty());
     assert!(oi.max > 0.04 && oi.max <= 0.05 + 1e-12, "{}", oi.max);
+    // A tolerance just over the farthest sample, closer than the finest samples' covering
+    // radius: no sample is beyond it, but nothing proves it, so the bump is listed too.
+    let d = oi.max + 0.05 * (0.01 / 32.0);
+    let (oi, _) = final_measure(&input, &out, &index, 0.01, d);
+    assert!(oi.max <= d && oi.bound > d, "{} {}", oi.max, oi.bound);
+    assert!(!oi.far.is_empty());
+    for f in &oi.far {
+        assert!(f.distance <= d);
+        assert!(out.triangles[f.triangle as usize].contains(&40), "{f:?}");
+    }
 }
