@@ -17,6 +17,12 @@ use super::bvh::{Hint, PatchIndex, dist2};
 
 type P3 = [f64; 3];
 
+/// The covering radius of a barycentric grid of step `h`: every point of the triangle is within
+/// it of a sample.
+fn covering(h: f64) -> f64 {
+    h / 3f64.sqrt()
+}
+
 /// A sample farther from the other surface than the flag distance.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Far {
@@ -47,10 +53,10 @@ pub struct Sided {
 }
 
 /// The one-sided distance from the triangles `tris` over `pts` (those with `alive[t]`, when
-/// given) to `to`. Triangles farther than `flag`, or whose bound stays over `limit`, are listed
-/// in [`Sided::far`] (their farthest sample). A triangle whose
-/// bound (sampled maximum plus covering radius) exceeds `limit` is sampled again with spacing
-/// `fine` (pass `limit = f64::INFINITY` for one pass). Samples proven (by the Lipschitz bound
+/// given) to `to`. A triangle whose bound (sampled maximum plus covering radius) exceeds
+/// `limit` is sampled again with spacing `fine` (pass `limit = f64::INFINITY` for one pass).
+/// Triangles farther than `flag`, or whose bound stays over `limit`, are listed in
+/// [`Sided::far`] (their farthest sample). Samples proven (by the Lipschitz bound
 /// from the previous sample of their row) no farther than `floor` or than the maximum so far are
 /// not measured, so every distance reported is at least `floor`: pass 0 for exact values, or a
 /// lower bound of the answer to save time.
@@ -141,7 +147,7 @@ pub fn one_sided(
                     }
                 }
                 // Refine just enough for the bound to prove the limit (if it can).
-                if max + longest / n as f64 / 3f64.sqrt() > limit && fine_n > n && max < limit {
+                if max + covering(longest / n as f64) > limit && fine_n > n && max < limit {
                     let need = (longest / ((limit - max) * 3f64.sqrt())).ceil() as usize;
                     n = need.max(2 * n).min(fine_n);
                     continue 'again;
@@ -151,7 +157,7 @@ pub fn one_sided(
             let step = longest / n as f64;
             // Listed when farther than the flag, or when the finest samples cannot prove the
             // limit (the bound is then over it though every sample is within).
-            let listed = max > flag || max + step / 3f64.sqrt() > limit;
+            let listed = max > flag || max + covering(step) > limit;
             Per {
                 max,
                 step,
@@ -178,7 +184,7 @@ pub fn one_sided(
         let k = keys.binary_search(&sides[t]).unwrap_or(0);
         per_sheet[k].1 = per_sheet[k].1.max(p.max);
         out.max = out.max.max(p.max);
-        out.bound = out.bound.max(p.max + p.step / 3f64.sqrt());
+        out.bound = out.bound.max(p.max + covering(p.step));
         out.n_samples += p.n;
         if let Some(f) = p.far {
             out.far.push(f);

@@ -16,7 +16,8 @@
 //!    the new point projected onto the input, until it does not (or a bounded number of rounds);
 //! 4. validation of the output ([`crate::mesh::validate::validate_surface`], with the exact
 //!    self-intersection test), and the final measure with dense samples; where it finds the
-//!    output beyond `D` (between the repair's coarser samples) the triangles there are refined
+//!    output beyond `D` (between the repair's coarser samples), or cannot prove it within, the
+//!    triangles there are refined
 //!    as in the repair and the output validated and measured again (at most three times); the
 //!    run fails with [`SurfaceError::Tolerance`] if the distance still exceeds `D`.
 //!
@@ -315,11 +316,11 @@ pub fn improve_with_progress(
     for k in 0..opts.rounds {
         progress(&format!("round {} of {}", k + 1, opts.rounds));
         r.round();
-        // The rounds make necks as they collapse; open each as it appears.
+        // The rounds make necks as they collapse; open each as it appears (the last round's
+        // before the clean-up).
         r.open_necks();
     }
     progress("clean-up");
-    r.open_necks();
     // The clean-up may use a little more of the tolerance (the final measure has room).
     r.tol = 0.8 * d;
     for _ in 0..6 {
@@ -359,7 +360,8 @@ pub fn improve_with_progress(
         refine_where_far(&mut r, &oi, &io, |t| t);
     }
     // Validate and measure; where the dense measure finds the output beyond D (between the
-    // repair's samples), refine there and measure again, a bounded number of times.
+    // repair's samples) or cannot prove it within, refine there and measure again, a bounded
+    // number of times.
     let mut final_repairs = 0;
     let (out, oi, io) = loop {
         progress("validating");

@@ -29,6 +29,11 @@ pub(super) struct Tube {
     rho: f64,
 }
 
+/// The part of `u` across the unit direction `w`.
+fn across(u: P3, w: P3) -> P3 {
+    sub(u, scale(w, dot(u, w)))
+}
+
 /// The edge-length cap near a tube: this many radii at the neck...
 const TUBE_SIZE: f64 = 4.0;
 /// ...growing by this much per unit of distance beyond the radius.
@@ -80,18 +85,20 @@ impl Remesher<'_> {
     /// length along it) and inside its radius, moved out to the radius in the direction of `p`
     /// around the axis; elsewhere `q` itself.
     pub(super) fn lift(&self, p: P3, q: P3) -> P3 {
+        if self.tubes.is_empty() {
+            return q;
+        }
         for &i in self.tubes_near(q) {
             let t = &self.tubes[i as usize];
             let u = sub(q, t.g);
             let a = dot(u, t.w);
-            if a.abs() > self.l || norm(sub(u, scale(t.w, a))) >= t.rho {
+            if a.abs() > self.l || norm(across(u, t.w)) >= t.rho {
                 continue;
             }
-            let up = sub(p, t.g);
-            let across = sub(up, scale(t.w, dot(up, t.w)));
-            let r = norm(across);
+            let x = across(sub(p, t.g), t.w);
+            let r = norm(x);
             if r > 0.0 {
-                return add(add(t.g, scale(t.w, a)), scale(across, t.rho / r));
+                return add(add(t.g, scale(t.w, a)), scale(x, t.rho / r));
             }
         }
         q
@@ -167,10 +174,7 @@ impl Remesher<'_> {
                 continue;
             };
             // The corners' offsets across the tube.
-            let q = p.map(|x| {
-                let u = sub(x, g);
-                sub(u, scale(w, dot(u, w)))
-            });
+            let q = p.map(|x| across(sub(x, g), w));
             let k0 = (0..3)
                 .max_by(|&i, &j| dot(q[i], q[i]).total_cmp(&dot(q[j], q[j])))
                 .unwrap_or(0);
@@ -215,10 +219,7 @@ impl Remesher<'_> {
             }
             let rho = n
                 .iter()
-                .map(|&v| {
-                    let u = sub(self.pts[v as usize], g);
-                    norm(sub(u, scale(w, dot(u, w))))
-                })
+                .map(|&v| norm(across(sub(self.pts[v as usize], g), w)))
                 .sum::<f64>()
                 / 3.0;
             let known = self.tubes_near(g).iter().any(|&i| {
