@@ -72,7 +72,7 @@ pub struct StageArgs {
     #[arg(long)]
     pub adaptive_size: bool,
     /// Remeshing rounds (split, collapse, flip, relax).
-    #[arg(long, value_name = "N", default_value_t = 6)]
+    #[arg(long, value_name = "N", default_value_t = biotet::surface::DEFAULT_ROUNDS)]
     pub surface_rounds: usize,
 }
 

@@ -49,7 +49,7 @@ pub struct SurfaceOptions {
     /// Edges whose dihedral angle is below this (degrees) are kept as features; 0 keeps none
     /// for its angle alone. Default 30°.
     pub feature_angle_deg: f64,
-    /// Remeshing rounds. Default 6.
+    /// Remeshing rounds. Default [`DEFAULT_ROUNDS`].
     pub rounds: usize,
     /// The smallest triangle angle aimed at (degrees). Default 30°.
     pub target_angle_deg: f64,
@@ -64,13 +64,18 @@ pub struct SurfaceOptions {
     pub sample_spacing: Option<f64>,
 }
 
+/// Remeshing rounds by default: on the marching-cubes test surfaces a fifth and sixth round
+/// moved points by under 2% of the edge length (median) and left the tets no better (docs/
+/// benchmarks.md, session 22), for a quarter of the stage's time.
+pub const DEFAULT_ROUNDS: usize = 4;
+
 impl Default for SurfaceOptions {
     fn default() -> Self {
         SurfaceOptions {
             tolerance: 0.5,
             edge_length: None,
             feature_angle_deg: 30.0,
-            rounds: 6,
+            rounds: DEFAULT_ROUNDS,
             target_angle_deg: 30.0,
             sample_spacing: None,
             adaptive: false,
@@ -154,6 +159,12 @@ pub struct SurfaceReport {
     pub repair_rounds: usize,
     /// Wall-clock seconds.
     pub seconds: f64,
+    /// Seconds of the remeshing rounds and the clean-up.
+    pub seconds_remesh: f64,
+    /// Seconds of the repair (sampled measures and refinement where the output strays).
+    pub seconds_repair: f64,
+    /// Seconds of the final validation and dense measure (with any refinement they ask for).
+    pub seconds_measure: f64,
 }
 
 /// Why [`improve`] failed.
@@ -323,14 +334,21 @@ pub fn improve_with_progress(
     progress("clean-up");
     // The clean-up may use a little more of the tolerance (the final measure has room).
     r.tol = 0.8 * d;
-    for _ in 0..6 {
-        if r.clean_up() == 0 {
-            break;
+    // Then again with the needles whose short edge neither end can move along (longer than
+    // the tolerance) collapsed to their middle; only now, so the first pass has done what it
+    // can (wm_20k: a 1.4° tet where both ran in one pass, none under 10° this way).
+    for middle in [false, true] {
+        r.middle = middle;
+        for _ in 0..6 {
+            if r.clean_up() == 0 {
+                break;
+            }
+            r.flips();
         }
-        r.flips();
     }
     // Repair: split where the output strays farther than 0.9 D (samples spaced D), while the
     // number of such places falls.
+    let seconds_remesh = clock.elapsed().as_secs_f64();
     let mut repair_rounds = 0;
     let work_spacing = spacing;
     r.repairing = true;
@@ -362,6 +380,7 @@ pub fn improve_with_progress(
     // Validate and measure; where the dense measure finds the output beyond D (between the
     // repair's samples) or cannot prove it within, refine there and measure again, a bounded
     // number of times.
+    let seconds_repair = clock.elapsed().as_secs_f64() - seconds_remesh;
     let mut final_repairs = 0;
     let (out, oi, io) = loop {
         progress("validating");
@@ -392,6 +411,7 @@ pub fn improve_with_progress(
         refine_where_far(&mut r, &oi, &io, |t| ids[t as usize]);
         repair_rounds += 1;
     };
+    let seconds_measure = clock.elapsed().as_secs_f64() - seconds_remesh - seconds_repair;
     if oi.max > d || io.max > d {
         return Err(SurfaceError::Tolerance {
             tolerance: d,
@@ -469,6 +489,9 @@ pub fn improve_with_progress(
         ops: r.counts,
         repair_rounds,
         seconds: clock.elapsed().as_secs_f64(),
+        seconds_remesh,
+        seconds_repair,
+        seconds_measure,
     };
     Ok((out, report))
 }

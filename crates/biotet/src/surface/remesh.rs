@@ -38,6 +38,7 @@ use crate::mesh::surface::SurfaceMesh;
 type P3 = [f64; 3];
 
 mod necks;
+mod sweep;
 
 /// Smallest and largest angle of a triangle, in degrees.
 pub fn angles_deg(t: &[P3; 3]) -> (f64, f64) {
@@ -71,6 +72,17 @@ pub fn min_angle_deg(t: &[P3; 3]) -> f64 {
     } else {
         angles_deg(t).0
     }
+}
+
+/// A checked point move ([`Remesher::check_move`]): the point, where it goes, its new target
+/// size (a relaxation takes the input's there), its fan's new distance bounds and the input
+/// samples' new covers.
+struct Move {
+    v: u32,
+    x: P3,
+    size: Option<f64>,
+    devs: Vec<(f64, u8)>,
+    plan: Vec<(u32, u32, f64)>,
 }
 
 /// Counts of applied operations.
@@ -133,6 +145,9 @@ pub struct Remesher<'a> {
     pub counts: OpCounts,
     /// Repair mode: a projection may lower the smallest angle (the distance comes first).
     pub repairing: bool,
+    /// Whether [`Self::clean_up`] may collapse a needle's short edge to its middle
+    /// ([`Self::collapse_mid`]).
+    pub middle: bool,
     /// The tubes of the necks opened so far ([`necks`]), and a hash of them by place.
     tubes: Vec<necks::Tube>,
     tube_cells: FxHashMap<[i32; 3], Vec<u32>>,
@@ -189,6 +204,7 @@ impl<'a> Remesher<'a> {
             target_angle: 30.0,
             counts: OpCounts::default(),
             repairing: false,
+            middle: false,
             tubes: Vec::new(),
             tube_cells: FxHashMap::default(),
         }
@@ -562,14 +578,26 @@ impl<'a> Remesher<'a> {
 
     /// Move point `v` to `x` if every check passes.
     pub fn try_move(&mut self, v: u32, x: P3) -> bool {
-        if self.is_fixed(v) || x == self.pts[v as usize] {
-            return false;
+        match self.check_move(v, x) {
+            Some(m) => {
+                self.apply_move(m);
+                true
+            }
+            None => false,
         }
-        let fan = self.vt[v as usize].clone();
+    }
+
+    /// The move of point `v` to `x` with everything [`Self::apply_move`] needs, if every check
+    /// passes; reads the surface only.
+    fn check_move(&self, v: u32, x: P3) -> Option<Move> {
+        if self.is_fixed(v) || x == self.pts[v as usize] {
+            return None;
+        }
+        let fan = &self.vt[v as usize];
         let floor = if self.repairing {
             0.0
         } else {
-            self.worst_angle(&fan).min(self.target_angle)
+            self.worst_angle(fan).min(self.target_angle)
         };
         let old_normals: Vec<P3> = fan.iter().map(|&t| unit_normal(&self.corners(t))).collect();
         let new: Vec<([u32; 3], [P3; 3])> = fan
@@ -583,19 +611,34 @@ impl<'a> Remesher<'a> {
             })
             .collect();
         if !self.shape_ok(&new, &old_normals, floor) {
-            return false;
+            return None;
         }
         let moved = dist2(x, self.pts[v as usize]).sqrt();
-        let Some(devs) = self.new_near_input(&new, &fan, Some((v, moved))) else {
-            return false;
-        };
-        let Some(plan) = self.recover_samples(&fan, &new, &fan, moved) else {
-            return false;
-        };
-        if self.crosses(&new, &fan) {
-            return false;
+        let devs = self.new_near_input(&new, fan, Some((v, moved)))?;
+        let plan = self.recover_samples(fan, &new, fan, moved)?;
+        if self.crosses(&new, fan) {
+            return None;
         }
+        Some(Move {
+            v,
+            x,
+            size: None,
+            devs,
+            plan,
+        })
+    }
+
+    /// Apply a move [`Self::check_move`] made on the surface as it stands.
+    fn apply_move(&mut self, m: Move) {
+        let Move {
+            v,
+            x,
+            size,
+            devs,
+            plan,
+        } = m;
         self.apply_covers(&plan);
+        let fan = std::mem::take(&mut self.vt[v as usize]);
         for (&t, d) in fan.iter().zip(devs) {
             self.dev[t as usize] = d;
         }
@@ -603,13 +646,16 @@ impl<'a> Remesher<'a> {
             self.grid.remove(t);
         }
         self.pts[v as usize] = x;
+        if let Some(h) = size {
+            self.size[v as usize] = h;
+        }
         for &t in &fan {
             self.touch(t);
             let c = self.corners(t);
             self.grid.insert(t, &c);
         }
+        self.vt[v as usize] = fan;
         self.counts.moves += 1;
-        true
     }
 
     /// Split edge `ab` at its midpoint, then try to project the new point onto the input.
@@ -749,6 +795,110 @@ impl<'a> Remesher<'a> {
         true
     }
 
+    /// Collapse edge `ab` to one point near its middle (projected onto the input), where
+    /// neither end may move onto the other: a needle's short edge longer than the tolerance
+    /// (each end then moves by half of it). The checks of [`Self::collapse`], over both fans,
+    /// with both old points within the tolerance of the new fan.
+    pub fn collapse_mid(&mut self, a: u32, b: u32, factor: f64) -> bool {
+        if self.is_fixed(a) || self.is_fixed(b) || self.feature.contains(&key(a, b)) {
+            return false;
+        }
+        let Some((t1, t2, c, d)) = self.edge_pair(a, b) else {
+            return false;
+        };
+        if c == d {
+            return false;
+        }
+        let na = self.neighbours(a);
+        let nb = self.neighbours(b);
+        let common = na.iter().filter(|x| nb.binary_search(x).is_ok()).count();
+        if common != 2 {
+            return false;
+        }
+        let (da, db) = (self.vt[a as usize].len(), self.vt[b as usize].len());
+        if da + db < 7 || self.vt[c as usize].len() < 4 || self.vt[d as usize].len() < 4 {
+            return false;
+        }
+        // No new neck: a neighbour of `a` joined to one of `b` by an edge would make a 3-cycle
+        // around the merged point that bounds no triangle.
+        let others = |n: &[u32]| -> Vec<u32> {
+            n.iter()
+                .copied()
+                .filter(|&u| u != a && u != b && u != c && u != d)
+                .collect()
+        };
+        let (oa, ob) = (others(&na), others(&nb));
+        if oa.iter().any(|&u| ob.iter().any(|&w| self.has_edge(u, w))) {
+            return false;
+        }
+        let (pa, pb) = (self.pts[a as usize], self.pts[b as usize]);
+        let Some((x, h)) = self.project(b, scale(add(pa, pb), 0.5)) else {
+            return false;
+        };
+        if na.iter().chain(&nb).any(|&u| {
+            let m = factor * self.target(b, u);
+            u != a && u != b && dist2(self.pts[u as usize], x) > m * m
+        }) {
+            return false;
+        }
+        let mut fan: Vec<u32> = self.vt[a as usize].clone();
+        fan.extend_from_slice(&self.vt[b as usize]);
+        fan.sort_unstable();
+        fan.dedup();
+        let kept: Vec<u32> = fan
+            .iter()
+            .copied()
+            .filter(|&t| t != t1 && t != t2)
+            .collect();
+        let floor = self.worst_angle(&fan).min(self.target_angle);
+        let old_normals: Vec<P3> = kept
+            .iter()
+            .map(|&t| unit_normal(&self.corners(t)))
+            .collect();
+        let new: Vec<([u32; 3], [P3; 3])> = kept
+            .iter()
+            .map(|&t| {
+                let tri = self.tris[t as usize].map(|u| if u == a { b } else { u });
+                (
+                    tri,
+                    tri.map(|u| if u == b { x } else { self.pts[u as usize] }),
+                )
+            })
+            .collect();
+        if !self.shape_ok(&new, &old_normals, floor) {
+            return false;
+        }
+        let Some(devs) = self.new_near_input(&new, &kept, None) else {
+            return false;
+        };
+        let t2r = self.tol * self.tol;
+        if [pa, pb]
+            .iter()
+            .any(|&p| !new.iter().any(|(_, c)| within(p, c, self.tol, t2r)))
+        {
+            return false;
+        }
+        let Some(plan) = self.recover_samples(&fan, &new, &kept, 0.0) else {
+            return false;
+        };
+        if self.crosses(&new, &fan) {
+            return false;
+        }
+        self.kill(t1);
+        self.kill(t2);
+        self.pts[b as usize] = x;
+        self.size[b as usize] = self.size[b as usize].min(h);
+        for (&t, (tri, _)) in kept.iter().zip(&new) {
+            self.replace(t, *tri);
+        }
+        self.apply_covers(&plan);
+        for (&t, d) in kept.iter().zip(devs) {
+            self.dev[t as usize] = d;
+        }
+        self.counts.collapses += 1;
+        true
+    }
+
     /// Flip edge `ab` to `cd` if that raises the smaller of the two triangles' smallest angles
     /// and every check passes.
     pub fn flip(&mut self, a: u32, b: u32) -> bool {
@@ -822,8 +972,27 @@ impl<'a> Remesher<'a> {
     /// Tangential relaxation of `v`: towards the mean of its neighbours within its tangent
     /// plane, then onto the input.
     pub fn relax(&mut self, v: u32) -> bool {
+        match self.check_relax(v) {
+            Some(m) => {
+                self.apply_move(m);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// [`Self::relax`]'s move of `v`, checked, without applying it.
+    fn check_relax(&self, v: u32) -> Option<Move> {
+        let (x, h) = self.relax_target(v)?;
+        let mut m = self.check_move(v, x)?;
+        m.size = Some(h);
+        Some(m)
+    }
+
+    /// Where [`Self::relax`] would move `v` (unchecked), and the input's target size there.
+    fn relax_target(&self, v: u32) -> Option<(P3, f64)> {
         if self.is_fixed(v) || self.vt[v as usize].is_empty() {
-            return false;
+            return None;
         }
         let nb = self.neighbours(v);
         let mut q = [0.0; 3];
@@ -834,14 +1003,7 @@ impl<'a> Remesher<'a> {
         let p = self.pts[v as usize];
         let n = self.vertex_normal(v);
         let q = sub(q, scale(n, dot(n, sub(q, p))));
-        let Some((x, h)) = self.project(v, q) else {
-            return false;
-        };
-        let moved = self.try_move(v, x);
-        if moved {
-            self.size[v as usize] = h;
-        }
-        moved
+        self.project(v, q)
     }
 
     /// The current edges `(a, b)`, `a < b`, sorted.
@@ -915,11 +1077,7 @@ impl<'a> Remesher<'a> {
             }
         }
         self.flips();
-        for v in 0..self.pts.len() as u32 {
-            if !self.vt[v as usize].is_empty() {
-                self.relax(v);
-            }
-        }
+        self.relax_all();
     }
 
     /// Flip edges until no flip raises an angle (bounded number of sweeps).
@@ -972,6 +1130,11 @@ impl<'a> Remesher<'a> {
                 }
                 ok = self.collapse(a, b, hi * 1.25) || self.collapse(b, a, hi * 1.25);
             }
+            // A needle whose short edge is too long for either end to move onto the other.
+            if !ok && self.middle {
+                let (_, a, b) = e[0];
+                ok = self.collapse_mid(a, b, hi * 1.25);
+            }
             // A cap (an angle over 120°): split the edge opposite it.
             if !ok && angles_deg(&self.corners(t)).1 > 120.0 {
                 let (_, a, b) = e[2];
@@ -1011,14 +1174,14 @@ impl<'a> Remesher<'a> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::super::{features, guard::InputSamples, median_edge_length, tests::uv_sphere};
     use super::*;
 
     /// What a [`Remesher`] borrows, for surface `s` at tolerance `d` and edge length `l`, set
     /// up as the stage does (samples spaced `max(d, l/4)`, uniform sizes, 0.7 D working
     /// tolerance).
-    struct Fixture {
+    pub(super) struct Fixture {
         f: Features,
         index: PatchIndex,
         samples: InputSamples,
@@ -1027,7 +1190,7 @@ mod tests {
     }
 
     impl Fixture {
-        fn new(s: &SurfaceMesh, d: f64, l: f64) -> Fixture {
+        pub(crate) fn new(s: &SurfaceMesh, d: f64, l: f64) -> Fixture {
             Fixture {
                 f: features::find(s, 30.0),
                 index: PatchIndex::new(&s.points, &s.triangles, &s.sides, None),
@@ -1037,7 +1200,7 @@ mod tests {
             }
         }
 
-        fn remesher<'a>(&'a self, s: &SurfaceMesh, d: f64, l: f64) -> Remesher<'a> {
+        pub(crate) fn remesher<'a>(&'a self, s: &SurfaceMesh, d: f64, l: f64) -> Remesher<'a> {
             Remesher::new(
                 s,
                 &self.f,

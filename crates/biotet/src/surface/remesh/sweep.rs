@@ -1,0 +1,233 @@
+//! One relaxation sweep over every point, its checks run in parallel where points are far apart.
+//!
+//! The points are bucketed in cubes a few edge lengths wide, and the cubes in eight classes by
+//! the parity of their coordinates. Each step takes the `k`-th point (by index) of every cube of
+//! one class: their moves are checked in parallel against the surface as it stands (checking
+//! reads the surface only; [`Remesher::check_relax`]), then applied one by one in cube order. Two
+//! points of a step lie in different cubes of one parity, a cube's width apart, which is more
+//! than the reach of a move (its fan's box, grown by the tolerance the distance checks look
+//! within) in all but rare cases; a move whose reach meets that of a move applied before it in
+//! the step is checked again first. So a sweep gives what checking and applying one point at a
+//! time in this order gives, on any number of threads.
+
+use rayon::prelude::*;
+use rustc_hash::FxHashMap;
+
+use super::{Move, P3, Remesher};
+
+/// Fewer points than this in a step are checked on the calling thread.
+const PARALLEL_STEP: usize = 8;
+
+/// An axis-aligned box.
+type Boxed = (P3, P3);
+
+fn meets(a: &Boxed, b: &Boxed) -> bool {
+    (0..3).all(|k| a.0[k] <= b.1[k] && b.0[k] <= a.1[k])
+}
+
+/// The boxes of the moves applied in a step, hashed by the cells they cover.
+struct Taken {
+    h: f64,
+    boxes: Vec<Boxed>,
+    cells: FxHashMap<[i64; 3], Vec<u32>>,
+}
+
+impl Taken {
+    fn new(h: f64) -> Taken {
+        Taken {
+            h,
+            boxes: Vec::new(),
+            cells: FxHashMap::default(),
+        }
+    }
+
+    fn cells(&self, b: &Boxed) -> impl Iterator<Item = [i64; 3]> + use<> {
+        let lo = b.0.map(|x| (x / self.h).floor() as i64);
+        let hi = b.1.map(|x| (x / self.h).floor() as i64);
+        (lo[0]..=hi[0]).flat_map(move |i| {
+            (lo[1]..=hi[1]).flat_map(move |j| (lo[2]..=hi[2]).map(move |k| [i, j, k]))
+        })
+    }
+
+    fn add(&mut self, b: Boxed) {
+        let id = self.boxes.len() as u32;
+        for c in self.cells(&b) {
+            self.cells.entry(c).or_default().push(id);
+        }
+        self.boxes.push(b);
+    }
+
+    fn meets(&self, b: &Boxed) -> bool {
+        self.cells(b).any(|c| {
+            self.cells
+                .get(&c)
+                .is_some_and(|ids| ids.iter().any(|&i| meets(&self.boxes[i as usize], b)))
+        })
+    }
+
+    fn clear(&mut self) {
+        self.boxes.clear();
+        self.cells.clear();
+    }
+}
+
+impl Remesher<'_> {
+    /// Relax every point once ([`Self::relax`]), in the order of the module's steps; the number
+    /// of moves checked again.
+    pub fn relax_all(&mut self) -> usize {
+        // The distance checks look within the working tolerance (a margin for rounding).
+        let reach = self.tol.max(0.0) * (1.0 + 1e-6);
+        let cube = 4.0 * self.l + 4.0 * reach;
+        let mut taken = Taken::new(cube / 4.0);
+        let mut again = 0;
+        for step in self.steps(cube) {
+            again += self.relax_step(&step, reach, &mut taken);
+        }
+        again
+    }
+
+    /// The points to relax, step by step: the `k`-th point of every cube (side `cube`) of one
+    /// parity class, classes in turn.
+    fn steps(&self, cube: f64) -> Vec<Vec<u32>> {
+        let points = (0..self.pts.len() as u32)
+            .filter(|&v| !self.vt[v as usize].is_empty() && !self.is_fixed(v));
+        if !(cube.is_finite() && cube > 0.0) {
+            return points.map(|v| vec![v]).collect();
+        }
+        // (class, cube, point), sorted: each class's cubes in order, each cube's points in order.
+        let mut order: Vec<(u8, [i64; 3], u32)> = points
+            .map(|v| {
+                let c = self.pts[v as usize].map(|x| (x / cube).floor() as i64);
+                let class = (c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2;
+                (class as u8, c, v)
+            })
+            .collect();
+        order.sort_unstable();
+        let mut steps = Vec::new();
+        let mut i = 0;
+        while i < order.len() {
+            let class = order[i].0;
+            let end = i + order[i..].partition_point(|x| x.0 == class);
+            // The cubes of this class: ranges of `order`.
+            let mut cubes: Vec<(usize, usize)> = Vec::new();
+            let mut a = i;
+            while a < end {
+                let b = a + order[a..end].partition_point(|x| x.1 == order[a].1);
+                cubes.push((a, b));
+                a = b;
+            }
+            let depth = cubes.iter().map(|&(a, b)| b - a).max().unwrap_or(0);
+            for k in 0..depth {
+                steps.push(
+                    cubes
+                        .iter()
+                        .filter(|&&(a, b)| a + k < b)
+                        .map(|&(a, _)| order[a + k].2)
+                        .collect(),
+                );
+            }
+            i = end;
+        }
+        steps
+    }
+
+    /// Check the moves of the points of `step` in parallel, then apply them in order.
+    fn relax_step(&mut self, step: &[u32], reach: f64, taken: &mut Taken) -> usize {
+        let checked: Vec<(Boxed, Option<Move>)> = if step.len() >= PARALLEL_STEP {
+            let this = &*self;
+            step.par_iter()
+                .map(|&v| this.checked_relax(v, reach))
+                .collect()
+        } else {
+            step.iter().map(|&v| self.checked_relax(v, reach)).collect()
+        };
+        taken.clear();
+        let mut again = 0;
+        for (&v, (read, m)) in step.iter().zip(checked) {
+            let (read, m) = if taken.meets(&read) {
+                again += 1;
+                self.checked_relax(v, reach)
+            } else {
+                (read, m)
+            };
+            if let Some(m) = m {
+                // What the move changes reaches a tolerance farther than what it read (the
+                // samples it hands to triangles near its fan).
+                taken.add(grow(read, reach));
+                self.apply_move(m);
+            }
+        }
+        again
+    }
+
+    /// [`Self::check_relax`] with the box its checks read: the fan's corners and the new
+    /// place, grown by `reach`.
+    fn checked_relax(&self, v: u32, reach: f64) -> (Boxed, Option<Move>) {
+        let target = self.relax_target(v);
+        let m = target.and_then(|(x, h)| {
+            let mut m = self.check_move(v, x)?;
+            m.size = Some(h);
+            Some(m)
+        });
+        let mut lo = self.pts[v as usize];
+        let mut hi = lo;
+        let mut take = |p: P3| {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        };
+        for &t in &self.vt[v as usize] {
+            for u in self.tris[t as usize] {
+                take(self.pts[u as usize]);
+            }
+        }
+        if let Some((x, _)) = target {
+            take(x);
+        }
+        (grow((lo, hi), reach), m)
+    }
+}
+
+fn grow(b: Boxed, r: f64) -> Boxed {
+    (b.0.map(|x| x - r), b.1.map(|x| x + r))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::tests::Fixture;
+    use crate::surface::{median_edge_length, tests::uv_sphere};
+
+    /// The sweep moves every point where relaxing the points one at a time in its order would:
+    /// on a sphere whose triangles are ten target lengths long (so neighbours share a step and
+    /// moves must be checked again), to the bit.
+    #[test]
+    fn the_sweep_moves_points_as_one_at_a_time_would() {
+        let s = uv_sphere(1.0, [0.0; 3], 24, 12);
+        let l = 0.1 * median_edge_length(&s);
+        let d = 0.02;
+        let fx = Fixture::new(&s, d, l);
+        let mut swept = fx.remesher(&s, d, l);
+        let mut serial = fx.remesher(&s, d, l);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .expect("pool");
+        let mut again = 0;
+        for _ in 0..3 {
+            let reach = serial.tol * (1.0 + 1e-6);
+            for step in serial.steps(4.0 * serial.l + 4.0 * reach) {
+                for v in step {
+                    serial.relax(v);
+                }
+            }
+            again += pool.install(|| swept.relax_all());
+        }
+        assert!(again > 0, "no move was checked again");
+        assert!(swept.counts.moves > 0);
+        assert_eq!(swept.counts, serial.counts);
+        let bits =
+            |p: &[[f64; 3]]| -> Vec<[u64; 3]> { p.iter().map(|x| x.map(f64::to_bits)).collect() };
+        assert_eq!(bits(&swept.pts), bits(&serial.pts));
+    }
+}
