@@ -719,7 +719,20 @@ impl<'a> Remesher<'a> {
 
     /// Collapse edge `ab` by removing `a` (its triangles then use `b`), if every check passes.
     pub fn collapse(&mut self, a: u32, b: u32, factor: f64) -> bool {
-        if self.is_fixed(a) || self.feature.contains(&key(a, b)) {
+        self.collapse_to(a, b, false, factor)
+    }
+
+    /// Collapse edge `ab` to one point near its middle (projected onto the input), where
+    /// neither end may move onto the other: a needle's short edge longer than the tolerance
+    /// (each end then moves by half of it). The checks of [`Self::collapse`] over both fans,
+    /// both old points within the tolerance of the new fan, and no new neck.
+    pub fn collapse_mid(&mut self, a: u32, b: u32, factor: f64) -> bool {
+        self.collapse_to(a, b, true, factor)
+    }
+
+    /// [`Self::collapse`] (`b` stays) or [`Self::collapse_mid`] (`b` moves to the middle).
+    fn collapse_to(&mut self, a: u32, b: u32, middle: bool, factor: f64) -> bool {
+        if self.is_fixed(a) || (middle && self.is_fixed(b)) || self.feature.contains(&key(a, b)) {
             return false;
         }
         let Some((t1, t2, c, d)) = self.edge_pair(a, b) else {
@@ -739,112 +752,41 @@ impl<'a> Remesher<'a> {
         if da + db < 7 || self.vt[c as usize].len() < 4 || self.vt[d as usize].len() < 4 {
             return false;
         }
-        let pb = self.pts[b as usize];
-        let pa = self.pts[a as usize];
-        if na.iter().any(|&x| {
-            let m = factor * self.target(b, x);
-            dist2(self.pts[x as usize], pb) > m * m
-        }) {
-            return false;
-        }
-        let fan: Vec<u32> = self.vt[a as usize].clone();
-        let kept: Vec<u32> = fan
-            .iter()
-            .copied()
-            .filter(|&t| t != t1 && t != t2)
-            .collect();
-        let floor = self.worst_angle(&fan).min(self.target_angle);
-        let old_normals: Vec<P3> = kept
-            .iter()
-            .map(|&t| unit_normal(&self.corners(t)))
-            .collect();
-        let new: Vec<([u32; 3], [P3; 3])> = kept
-            .iter()
-            .map(|&t| {
-                let tri = self.tris[t as usize].map(|u| if u == a { b } else { u });
-                (tri, tri.map(|u| self.pts[u as usize]))
-            })
-            .collect();
-        if !self.shape_ok(&new, &old_normals, floor) {
-            return false;
-        }
-        let Some(devs) = self.new_near_input(&new, &kept, None) else {
-            return false;
-        };
-        // The removed point lay on (or near) the input: the new fan must pass near it.
-        let t2r = self.tol * self.tol;
-        if !new.iter().any(|(_, c)| within(pa, c, self.tol, t2r)) {
-            return false;
-        }
-        let Some(plan) = self.recover_samples(&fan, &new, &kept, 0.0) else {
-            return false;
-        };
-        if self.crosses(&new, &fan) {
-            return false;
-        }
-        self.kill(t1);
-        self.kill(t2);
-        for (&t, (tri, _)) in kept.iter().zip(&new) {
-            self.replace(t, *tri);
-        }
-        self.apply_covers(&plan);
-        for (&t, d) in kept.iter().zip(devs) {
-            self.dev[t as usize] = d;
-        }
-        self.counts.collapses += 1;
-        true
-    }
-
-    /// Collapse edge `ab` to one point near its middle (projected onto the input), where
-    /// neither end may move onto the other: a needle's short edge longer than the tolerance
-    /// (each end then moves by half of it). The checks of [`Self::collapse`], over both fans,
-    /// with both old points within the tolerance of the new fan.
-    pub fn collapse_mid(&mut self, a: u32, b: u32, factor: f64) -> bool {
-        if self.is_fixed(a) || self.is_fixed(b) || self.feature.contains(&key(a, b)) {
-            return false;
-        }
-        let Some((t1, t2, c, d)) = self.edge_pair(a, b) else {
-            return false;
-        };
-        if c == d {
-            return false;
-        }
-        let na = self.neighbours(a);
-        let nb = self.neighbours(b);
-        let common = na.iter().filter(|x| nb.binary_search(x).is_ok()).count();
-        if common != 2 {
-            return false;
-        }
-        let (da, db) = (self.vt[a as usize].len(), self.vt[b as usize].len());
-        if da + db < 7 || self.vt[c as usize].len() < 4 || self.vt[d as usize].len() < 4 {
-            return false;
-        }
-        // No new neck: a neighbour of `a` joined to one of `b` by an edge would make a 3-cycle
-        // around the merged point that bounds no triangle.
-        let others = |n: &[u32]| -> Vec<u32> {
-            n.iter()
-                .copied()
-                .filter(|&u| u != a && u != b && u != c && u != d)
-                .collect()
-        };
-        let (oa, ob) = (others(&na), others(&nb));
-        if oa.iter().any(|&u| ob.iter().any(|&w| self.has_edge(u, w))) {
-            return false;
-        }
         let (pa, pb) = (self.pts[a as usize], self.pts[b as usize]);
-        let Some((x, h)) = self.project(b, scale(add(pa, pb), 0.5)) else {
-            return false;
+        let (x, h) = if middle {
+            // No new neck: a neighbour of `a` joined to one of `b` by an edge would make a
+            // 3-cycle around the merged point that bounds no triangle.
+            let others = |n: &[u32]| -> Vec<u32> {
+                n.iter()
+                    .copied()
+                    .filter(|&u| u != a && u != b && u != c && u != d)
+                    .collect()
+            };
+            let (oa, ob) = (others(&na), others(&nb));
+            if oa.iter().any(|&u| ob.iter().any(|&w| self.has_edge(u, w))) {
+                return false;
+            }
+            let Some((x, h)) = self.project(b, scale(add(pa, pb), 0.5)) else {
+                return false;
+            };
+            (x, Some(h))
+        } else {
+            (pb, None)
         };
-        if na.iter().chain(&nb).any(|&u| {
+        // The new edges from the merged point (`b`'s own ones change only if it moves).
+        let moved_nb: &[u32] = if middle { &nb } else { &[] };
+        if na.iter().chain(moved_nb).any(|&u| {
             let m = factor * self.target(b, u);
             u != a && u != b && dist2(self.pts[u as usize], x) > m * m
         }) {
             return false;
         }
         let mut fan: Vec<u32> = self.vt[a as usize].clone();
-        fan.extend_from_slice(&self.vt[b as usize]);
-        fan.sort_unstable();
-        fan.dedup();
+        if middle {
+            fan.extend_from_slice(&self.vt[b as usize]);
+            fan.sort_unstable();
+            fan.dedup();
+        }
         let kept: Vec<u32> = fan
             .iter()
             .copied()
@@ -871,8 +813,10 @@ impl<'a> Remesher<'a> {
         let Some(devs) = self.new_near_input(&new, &kept, None) else {
             return false;
         };
+        // The removed points lay on (or near) the input: the new fan must pass near them.
         let t2r = self.tol * self.tol;
-        if [pa, pb]
+        let removed: &[P3] = if middle { &[pa, pb] } else { &[pa] };
+        if removed
             .iter()
             .any(|&p| !new.iter().any(|(_, c)| within(p, c, self.tol, t2r)))
         {
@@ -887,7 +831,9 @@ impl<'a> Remesher<'a> {
         self.kill(t1);
         self.kill(t2);
         self.pts[b as usize] = x;
-        self.size[b as usize] = self.size[b as usize].min(h);
+        if let Some(h) = h {
+            self.size[b as usize] = self.size[b as usize].min(h);
+        }
         for (&t, (tri, _)) in kept.iter().zip(&new) {
             self.replace(t, *tri);
         }
