@@ -25,11 +25,15 @@ fn meets(a: &Boxed, b: &Boxed) -> bool {
     (0..3).all(|k| a.0[k] <= b.1[k] && b.0[k] <= a.1[k])
 }
 
-/// The boxes of the moves applied in a step, hashed by the cells they cover.
+/// A box over more cells than this is kept in a list instead (a long input triangle's fan).
+const MAX_CELLS: i64 = 64;
+
+/// The boxes of the moves applied in a step, hashed by the cells they cover (large ones listed).
 struct Taken {
     h: f64,
     boxes: Vec<Boxed>,
     cells: FxHashMap<[i64; 3], Vec<u32>>,
+    large: Vec<Boxed>,
 }
 
 impl Taken {
@@ -38,7 +42,17 @@ impl Taken {
             h,
             boxes: Vec::new(),
             cells: FxHashMap::default(),
+            large: Vec::new(),
         }
+    }
+
+    /// Whether box `b` covers more than [`MAX_CELLS`] cells (or coordinates out of range).
+    fn is_large(&self, b: &Boxed) -> bool {
+        let mut n = 1.0;
+        for k in 0..3 {
+            n *= ((b.1[k] / self.h).floor() - (b.0[k] / self.h).floor() + 1.0).max(1.0);
+        }
+        n.is_nan() || n > MAX_CELLS as f64
     }
 
     fn cells(&self, b: &Boxed) -> impl Iterator<Item = [i64; 3]> + use<> {
@@ -50,6 +64,10 @@ impl Taken {
     }
 
     fn add(&mut self, b: Boxed) {
+        if self.is_large(&b) {
+            self.large.push(b);
+            return;
+        }
         let id = self.boxes.len() as u32;
         for c in self.cells(&b) {
             self.cells.entry(c).or_default().push(id);
@@ -58,6 +76,12 @@ impl Taken {
     }
 
     fn meets(&self, b: &Boxed) -> bool {
+        if self.large.iter().any(|x| meets(x, b)) {
+            return true;
+        }
+        if self.is_large(b) {
+            return self.boxes.iter().any(|x| meets(x, b));
+        }
         self.cells(b).any(|c| {
             self.cells
                 .get(&c)
@@ -68,6 +92,7 @@ impl Taken {
     fn clear(&mut self) {
         self.boxes.clear();
         self.cells.clear();
+        self.large.clear();
     }
 }
 
