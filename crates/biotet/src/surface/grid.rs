@@ -36,6 +36,11 @@ impl Grid {
     /// List triangle `t` with corners `c`.
     pub fn insert(&mut self, t: u32, c: &[P3; 3]) {
         let (lo, hi) = bbox(c);
+        self.insert_box(t, lo, hi);
+    }
+
+    /// List item `t` over the box `lo..hi`.
+    pub fn insert_box(&mut self, t: u32, lo: P3, hi: P3) {
         let r = self.range(lo, hi);
         if self.of.len() <= t as usize {
             self.of.resize(t as usize + 1, None);
@@ -49,6 +54,12 @@ impl Grid {
                 }
             }
         }
+    }
+
+    /// Unlist everything.
+    pub fn clear(&mut self) {
+        self.cells.clear();
+        self.of.clear();
     }
 
     /// Unlist triangle `t`.

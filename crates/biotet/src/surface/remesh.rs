@@ -578,7 +578,7 @@ impl<'a> Remesher<'a> {
 
     /// Move point `v` to `x` if every check passes.
     pub fn try_move(&mut self, v: u32, x: P3) -> bool {
-        match self.check_move(v, x) {
+        match self.check_move(v, x, None) {
             Some(m) => {
                 self.apply_move(m);
                 true
@@ -587,9 +587,9 @@ impl<'a> Remesher<'a> {
         }
     }
 
-    /// The move of point `v` to `x` with everything [`Self::apply_move`] needs, if every check
-    /// passes; reads the surface only.
-    fn check_move(&self, v: u32, x: P3) -> Option<Move> {
+    /// The move of point `v` to `x` (and its target size to `size`, if given) with everything
+    /// [`Self::apply_move`] needs, if every check passes; reads the surface only.
+    fn check_move(&self, v: u32, x: P3, size: Option<f64>) -> Option<Move> {
         if self.is_fixed(v) || x == self.pts[v as usize] {
             return None;
         }
@@ -622,7 +622,7 @@ impl<'a> Remesher<'a> {
         Some(Move {
             v,
             x,
-            size: None,
+            size,
             devs,
             plan,
         })
@@ -930,9 +930,7 @@ impl<'a> Remesher<'a> {
     /// [`Self::relax`]'s move of `v`, checked, without applying it.
     fn check_relax(&self, v: u32) -> Option<Move> {
         let (x, h) = self.relax_target(v)?;
-        let mut m = self.check_move(v, x)?;
-        m.size = Some(h);
-        Some(m)
+        self.check_move(v, x, Some(h))
     }
 
     /// Where [`Self::relax`] would move `v` (unchecked), and the input's target size there.

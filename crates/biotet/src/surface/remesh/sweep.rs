@@ -11,9 +11,8 @@
 //! time in this order gives, on any number of threads.
 
 use rayon::prelude::*;
-use rustc_hash::FxHashMap;
 
-use super::{Move, P3, Remesher};
+use super::{Grid, Move, P3, Remesher};
 
 /// Fewer points than this in a step are checked on the calling thread.
 const PARALLEL_STEP: usize = 8;
@@ -25,74 +24,35 @@ fn meets(a: &Boxed, b: &Boxed) -> bool {
     (0..3).all(|k| a.0[k] <= b.1[k] && b.0[k] <= a.1[k])
 }
 
-/// A box over more cells than this is kept in a list instead (a long input triangle's fan).
-const MAX_CELLS: i64 = 64;
-
-/// The boxes of the moves applied in a step, hashed by the cells they cover (large ones listed).
+/// The boxes of the moves applied in a step, in a [`Grid`] by the cells they cover.
 struct Taken {
-    h: f64,
     boxes: Vec<Boxed>,
-    cells: FxHashMap<[i64; 3], Vec<u32>>,
-    large: Vec<Boxed>,
+    grid: Grid,
+    cand: Vec<u32>,
 }
 
 impl Taken {
     fn new(h: f64) -> Taken {
         Taken {
-            h,
             boxes: Vec::new(),
-            cells: FxHashMap::default(),
-            large: Vec::new(),
+            grid: Grid::new(h),
+            cand: Vec::new(),
         }
-    }
-
-    /// Whether box `b` covers more than [`MAX_CELLS`] cells (or coordinates out of range).
-    fn is_large(&self, b: &Boxed) -> bool {
-        let mut n = 1.0;
-        for k in 0..3 {
-            n *= ((b.1[k] / self.h).floor() - (b.0[k] / self.h).floor() + 1.0).max(1.0);
-        }
-        n.is_nan() || n > MAX_CELLS as f64
-    }
-
-    fn cells(&self, b: &Boxed) -> impl Iterator<Item = [i64; 3]> + use<> {
-        let lo = b.0.map(|x| (x / self.h).floor() as i64);
-        let hi = b.1.map(|x| (x / self.h).floor() as i64);
-        (lo[0]..=hi[0]).flat_map(move |i| {
-            (lo[1]..=hi[1]).flat_map(move |j| (lo[2]..=hi[2]).map(move |k| [i, j, k]))
-        })
     }
 
     fn add(&mut self, b: Boxed) {
-        if self.is_large(&b) {
-            self.large.push(b);
-            return;
-        }
-        let id = self.boxes.len() as u32;
-        for c in self.cells(&b) {
-            self.cells.entry(c).or_default().push(id);
-        }
+        self.grid.insert_box(self.boxes.len() as u32, b.0, b.1);
         self.boxes.push(b);
     }
 
-    fn meets(&self, b: &Boxed) -> bool {
-        if self.large.iter().any(|x| meets(x, b)) {
-            return true;
-        }
-        if self.is_large(b) {
-            return self.boxes.iter().any(|x| meets(x, b));
-        }
-        self.cells(b).any(|c| {
-            self.cells
-                .get(&c)
-                .is_some_and(|ids| ids.iter().any(|&i| meets(&self.boxes[i as usize], b)))
-        })
+    fn meets(&mut self, b: &Boxed) -> bool {
+        self.grid.query(b.0, b.1, &mut self.cand);
+        self.cand.iter().any(|&i| meets(&self.boxes[i as usize], b))
     }
 
     fn clear(&mut self) {
         self.boxes.clear();
-        self.cells.clear();
-        self.large.clear();
+        self.grid.clear();
     }
 }
 
@@ -189,11 +149,7 @@ impl Remesher<'_> {
     /// place, grown by `reach`.
     fn checked_relax(&self, v: u32, reach: f64) -> (Boxed, Option<Move>) {
         let target = self.relax_target(v);
-        let m = target.and_then(|(x, h)| {
-            let mut m = self.check_move(v, x)?;
-            m.size = Some(h);
-            Some(m)
-        });
+        let m = target.and_then(|(x, h)| self.check_move(v, x, Some(h)));
         let mut lo = self.pts[v as usize];
         let mut hi = lo;
         let mut take = |p: P3| {
