@@ -15,7 +15,7 @@ const LEAF: usize = 4;
 struct Node {
     lo: P3,
     hi: P3,
-    /// Leaf: `start..start + count` in `order`; inner: `start` is the right child (the left one
+    /// Leaf: `start..start + count` in `tris`; inner: `start` is the right child (the left one
     /// follows the node), `count == 0`.
     start: u32,
     count: u32,
@@ -85,10 +85,51 @@ impl NodeStack {
 /// A bounding-volume hierarchy over triangles, for closest-point queries.
 #[derive(Debug, Clone)]
 pub struct Bvh {
+    /// The triangles in leaf order (a leaf's are contiguous).
     tris: Vec<[P3; 3]>,
+    /// What [`within_d2`] computes before measuring, kept per triangle (same order).
+    pre: Vec<Pre>,
     ids: Vec<u32>,
-    order: Vec<u32>,
     nodes: Vec<Node>,
+}
+
+/// A triangle's box and unnormalized normal (and its squared length): the two cheap rejections
+/// of [`within_d2`], precomputed with the same arithmetic so the answers are the same.
+#[derive(Debug, Clone, Copy)]
+struct Pre {
+    lo: P3,
+    hi: P3,
+    n: P3,
+    nn: f64,
+}
+
+impl Pre {
+    fn new(t: &[P3; 3]) -> Pre {
+        let lo = [0, 1, 2].map(|k| t[0][k].min(t[1][k]).min(t[2][k]));
+        let hi = [0, 1, 2].map(|k| t[0][k].max(t[1][k]).max(t[2][k]));
+        let n = cross(sub(t[1], t[0]), sub(t[2], t[0]));
+        Pre {
+            lo,
+            hi,
+            n,
+            nn: dot(n, n),
+        }
+    }
+}
+
+/// [`within_d2`] with the rejections' data precomputed.
+#[inline]
+fn within_d2_pre(p: P3, t: &[P3; 3], pre: &Pre, r: f64, r2: f64) -> Option<f64> {
+    let m = r * (1.0 + 1e-9);
+    if (0..3).any(|k| p[k] < pre.lo[k] - m || p[k] > pre.hi[k] + m) {
+        return None;
+    }
+    let h = dot(sub(p, t[0]), pre.n);
+    if h * h > r2 * pre.nn * (1.0 + 1e-9) {
+        return None;
+    }
+    let d2 = dist2(p, closest_on_triangle(p, t));
+    (d2 <= r2).then_some(d2)
 }
 
 /// The closest point of triangle `t` to `p` (Voronoi regions of the corners, edges and face,
@@ -156,21 +197,7 @@ pub fn closest_on_triangle(p: P3, t: &[P3; 3]) -> P3 {
 /// deciding a borderline case differently from `dist2(p, closest_on_triangle(p, t)) <= r2`).
 #[inline]
 pub fn within_d2(p: P3, t: &[P3; 3], r: f64, r2: f64) -> Option<f64> {
-    let m = r * (1.0 + 1e-9);
-    for k in 0..3 {
-        let lo = t[0][k].min(t[1][k]).min(t[2][k]);
-        let hi = t[0][k].max(t[1][k]).max(t[2][k]);
-        if p[k] < lo - m || p[k] > hi + m {
-            return None;
-        }
-    }
-    let n = cross(sub(t[1], t[0]), sub(t[2], t[0]));
-    let h = dot(sub(p, t[0]), n);
-    if h * h > r2 * dot(n, n) * (1.0 + 1e-9) {
-        return None;
-    }
-    let d2 = dist2(p, closest_on_triangle(p, t));
-    (d2 <= r2).then_some(d2)
+    within_d2_pre(p, t, &Pre::new(t), r, r2)
 }
 
 /// Whether `p` is within `sqrt(r2)` of triangle `t` ([`within_d2`]).
@@ -233,10 +260,12 @@ impl Bvh {
         if n > 0 {
             build(&tris, &cent, &mut order, 0, n, &mut nodes);
         }
+        let tris: Vec<[P3; 3]> = order.iter().map(|&k| tris[k as usize]).collect();
+        let ids = order.iter().map(|&k| ids[k as usize]).collect();
         Bvh {
+            pre: tris.iter().map(Pre::new).collect(),
             tris,
             ids,
-            order,
             nodes,
         }
     }
@@ -268,7 +297,7 @@ impl Bvh {
                 continue;
             }
             if node.count > 0 {
-                for &k in &self.order[node.start as usize..(node.start + node.count) as usize] {
+                for k in node.start..node.start + node.count {
                     let q = closest_on_triangle(p, &self.tris[k as usize]);
                     let d = dist2(p, q);
                     if d < best.d2 || (d == best.d2 && best.triangle == u32::MAX) {
@@ -326,7 +355,8 @@ impl Bvh {
             if k == u32::MAX {
                 break;
             }
-            if let Some(d2) = within_d2(p, &self.tris[k as usize], r, r2) {
+            if let Some(d2) = within_d2_pre(p, &self.tris[k as usize], &self.pre[k as usize], r, r2)
+            {
                 hint.note(k);
                 return Some(d2);
             }
@@ -338,8 +368,9 @@ impl Bvh {
                 continue;
             }
             if node.count > 0 {
-                for &k in &self.order[node.start as usize..(node.start + node.count) as usize] {
-                    if let Some(d2) = within_d2(p, &self.tris[k as usize], r, r2) {
+                for k in node.start..node.start + node.count {
+                    let (t, pre) = (&self.tris[k as usize], &self.pre[k as usize]);
+                    if let Some(d2) = within_d2_pre(p, t, pre, r, r2) {
                         hint.note(k);
                         return Some(d2);
                     }

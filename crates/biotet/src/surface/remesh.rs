@@ -305,12 +305,12 @@ impl<'a> Remesher<'a> {
         sides: [u32; 2],
         n: u8,
         known: Option<(usize, f64, f64)>,
+        hint: &mut Hint,
     ) -> Option<f64> {
         let bvh = self.input.get(sides)?;
         let n = n as usize;
         let t2 = self.tol * self.tol;
         let lim = self.tol * (1.0 - 1e-9);
-        let mut hint = Hint::default();
         let mut worst = 0.0f64;
         for i in 0..=n {
             for j in 0..=n - i {
@@ -324,7 +324,7 @@ impl<'a> Remesher<'a> {
                     }
                 }
                 let p = [0, 1, 2].map(|a| w[0] * c[0][a] + w[1] * c[1][a] + w[2] * c[2][a]);
-                worst = worst.max(bvh.first_within_hinted(p, t2, &mut hint)?);
+                worst = worst.max(bvh.first_within_hinted(p, t2, hint)?);
             }
         }
         Some(worst.sqrt())
@@ -340,6 +340,9 @@ impl<'a> Remesher<'a> {
         ids: &[u32],
         moved: Option<(u32, f64)>,
     ) -> Option<Vec<(f64, u8)>> {
+        // One hint over the fan: its triangles are answered by the same few input triangles
+        // (the hint speeds the answer and does not change it).
+        let mut hint = Hint::default();
         new.iter()
             .zip(ids)
             .map(|((tri, c), &t)| {
@@ -349,7 +352,7 @@ impl<'a> Remesher<'a> {
                     let corner = tri.iter().position(|&x| x == v)?;
                     (dn == n).then_some((corner, d, m))
                 });
-                self.near_input(c, self.sides[t as usize], n, known)
+                self.near_input(c, self.sides[t as usize], n, known, &mut hint)
                     .map(|d| (d, n))
             })
             .collect()
@@ -444,21 +447,33 @@ impl<'a> Remesher<'a> {
     /// triangle other than in shared corners or a shared edge; triangles in `ignore` are about
     /// to go and are not tested.
     fn crosses(&self, new: &[([u32; 3], [P3; 3])], ignore: &[u32]) -> bool {
-        let mut cand = Vec::new();
+        let boxes: Vec<(P3, P3)> = new.iter().map(|(_, c)| bbox(c)).collect();
         for (i, (_, c)) in new.iter().enumerate() {
             for (_, d) in &new[..i] {
                 if !tri_tri(c, d).is_legal() {
                     return true;
                 }
             }
-            let (lo, hi) = bbox(c);
-            self.grid.query(lo, hi, &mut cand);
-            for &u in &cand {
-                if !self.alive[u as usize] || ignore.contains(&u) {
-                    continue;
-                }
-                let d = self.corners(u);
-                let (dlo, dhi) = bbox(&d);
+        }
+        // One query over all of them: the triangles around a fan are candidates of most of its
+        // triangles, and each is fetched once.
+        let Some((lo, hi)) = boxes.iter().copied().reduce(|(a, b), (c, d)| {
+            (
+                [0, 1, 2].map(|k| a[k].min(c[k])),
+                [0, 1, 2].map(|k| b[k].max(d[k])),
+            )
+        }) else {
+            return false;
+        };
+        let mut cand = Vec::new();
+        self.grid.query(lo, hi, &mut cand);
+        for &u in &cand {
+            if !self.alive[u as usize] || ignore.contains(&u) {
+                continue;
+            }
+            let d = self.corners(u);
+            let (dlo, dhi) = bbox(&d);
+            for ((_, c), (lo, hi)) in new.iter().zip(&boxes) {
                 if (0..3).any(|k| dlo[k] > hi[k] || dhi[k] < lo[k]) {
                     continue;
                 }
