@@ -275,6 +275,37 @@ impl Work {
         })
     }
 
+    /// Try to bring `t` (unforced, its smallest angle at or above `thr`, its largest above
+    /// `max_deg`) within range with one new interior point in its face cavity, then in the ring
+    /// of face neighbours around that: an obtuse tet whose corners are all on the surface (two
+    /// of its faces on a ridge of the boundary) has no interior corner to move or remove, and no
+    /// refill of its neighbours' points helps. Accepted as [`Work::insert`] accepts, the measure
+    /// being the range ([`Judge::Range`]).
+    #[allow(clippy::too_many_arguments)]
+    pub fn insert_obtuse(
+        &mut self,
+        t: u32,
+        thr: f64,
+        max_deg: f64,
+        searcher: &mut Searcher,
+        rp: &RefillParams,
+        sp: &StepParams,
+        star: &mut Vec<u32>,
+    ) -> Option<Vec<u32>> {
+        let label = self.labels[t as usize];
+        let faces = self.with_face_neighbours(t);
+        self.judge_by = Judge::Range { max_deg };
+        let mut out = self.insert_into(t, faces.clone(), thr, searcher, rp, sp, star);
+        if out.is_none() && self.alive[t as usize] {
+            let ring = self.face_ring(&faces, label);
+            if ring != faces {
+                out = self.insert_into(t, ring, thr, searcher, rp, sp, star);
+            }
+        }
+        self.judge_by = Judge::MinAngle;
+        out
+    }
+
     #[allow(clippy::too_many_arguments)]
     fn insert_into(
         &mut self,
@@ -295,7 +326,7 @@ impl Work {
         let large = tets.len() > 5;
         let (cav, on_shell) = self.cavity_of_shell_points(tets)?;
         let (x, cone_ok) = self.best_point(t, &cav.tets, &cav.shell, thr)?;
-        let old = judge(self, &cav.tets, thr, Judge::MinAngle);
+        let old = judge(self, &cav.tets, thr, self.judge_by);
         // In the last pass, a flat tet (under a thousandth of the threshold: gmsh's t13 kept two
         // at 3e-15°, a solver's stiffness matrix then singular to round-off) is traded for any
         // fill whose every tet is above a hundredth of it, however many are then below it.
@@ -311,7 +342,7 @@ impl Work {
             let cone: Vec<[u32; 4]> = cav.shell.iter().map(|f| [f[0], f[1], f[2], p]).collect();
             let ids = self.replace(&cav, &cone);
             self.relocate(p, thr.to_radians(), sp, star);
-            let new = judge(self, &ids, thr, Judge::MinAngle);
+            let new = judge(self, &ids, thr, self.judge_by);
             (ids, new)
         } else {
             (
@@ -343,7 +374,7 @@ impl Work {
                 if let Ok(f) = r {
                     let cur = self.cavity(ids);
                     ids = self.replace(&cur, &f.tets);
-                    new = judge(self, &ids, thr, Judge::MinAngle);
+                    new = judge(self, &ids, thr, self.judge_by);
                     filled = true;
                     break;
                 }

@@ -17,7 +17,8 @@
 //!
 //! Last, the **obtuse** step: an unforced tet whose largest dihedral angle is above
 //! [`PolishOptions::max_deg`] (its smallest already at or above the threshold) is refilled with
-//! its face neighbours, or an interior corner's star refilled without it (`obtuse`).
+//! its face neighbours, or an interior corner's star refilled without it, or split by one new
+//! interior point in its cavity (`obtuse`).
 //!
 //! Surface points (on a boundary or interface face) never move and are never removed, and no
 //! point is added on a boundary or interface face; every accepted change keeps every tet strictly
@@ -320,8 +321,14 @@ pub fn polish(mesh: &mut TetMesh, opts: &PolishOptions) -> PolishReport {
     }
     if opts.max_deg < 180.0 {
         let c = Instant::now();
-        let (before, after, changed) =
-            obtuse::run(&mut w, thr, opts.max_deg, &mut searcher, &mut star);
+        let (before, after, changed) = obtuse::run(
+            &mut w,
+            thr,
+            opts.max_deg,
+            &mut searcher,
+            (&rp, &params),
+            &mut star,
+        );
         report.n_obtuse_before = before;
         report.n_obtuse_after = after;
         report.ms[5] = c.elapsed().as_secs_f64() * 1e3;

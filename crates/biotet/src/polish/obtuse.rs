@@ -3,10 +3,12 @@
 //! smoothing can leave such a tet: on the MNI brain image 3 of 4 million, at 165.3–165.6°).
 //!
 //! Each, worst first, is refilled with its unforced face neighbours of its label, else an
-//! interior corner's star is refilled without that corner; a refill is accepted only when the
-//! cavity's worst measure rises, the measure being the smallest angle and, for the largest, its
-//! distance below the cap added to the threshold ([`Judge::Range`]), and no tet falls below the
-//! threshold that was not. Points on the surface never move and no point is added.
+//! interior corner's star is refilled without that corner, else one new interior point is put
+//! in its face cavity or the ring around it ([`Work::insert_obtuse`]: a tet with its four corners
+//! on the surface, two faces on a ridge, has nothing else to change); a change is accepted only
+//! when the cavity's worst measure rises, the measure being the smallest angle and, for the
+//! largest, its distance below the cap added to the threshold ([`Judge::Range`]), and no tet
+//! falls below the threshold that was not. Points on the surface never move.
 
 use rayon::prelude::*;
 
@@ -14,6 +16,7 @@ use crate::lastresort::Searcher;
 use crate::quality::tet::max_dihedral_chord2;
 
 use super::refill::{Judge, RefillParams};
+use super::relocate::StepParams;
 use super::work::Work;
 
 /// Refill budget: the fill with the best worst tet is wanted, not the first.
@@ -23,12 +26,14 @@ const PARAMS: RefillParams = RefillParams {
     max_tets: 200,
 };
 
-/// Run the step; returns the obtuse tets before and after, and whether any tet changed.
+/// Run the step (`rp` and `sp` are the insertions' search and move parameters); returns the
+/// obtuse tets before and after, and whether any tet changed.
 pub(super) fn run(
     w: &mut Work,
     thr: f64,
     max_deg: f64,
     searcher: &mut Searcher,
+    (rp, sp): (&RefillParams, &StepParams),
     star: &mut Vec<u32>,
 ) -> (usize, usize, bool) {
     let by = Judge::Range { max_deg };
@@ -45,6 +50,7 @@ pub(super) fn run(
             check.extend(ids);
             continue;
         }
+        let mut done = false;
         for v in w.tets[t as usize] {
             if w.fixed[v as usize] {
                 continue;
@@ -52,8 +58,12 @@ pub(super) fn run(
             w.star(v, star);
             if let Some(ids) = w.refill(searcher, star.clone(), Some(v), true, thr, &PARAMS, by) {
                 check.extend(ids);
+                done = true;
                 break;
             }
+        }
+        if !done && let Some(ids) = w.insert_obtuse(t, thr, max_deg, searcher, rp, sp, star) {
+            check.extend(ids);
         }
     }
     let changed = check.len() > before;
