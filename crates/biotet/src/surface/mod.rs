@@ -340,10 +340,11 @@ pub fn improve_with_progress(
     for middle in [false, true] {
         r.middle = middle;
         for _ in 0..6 {
+            let since = r.clock();
             if r.clean_up() == 0 {
                 break;
             }
-            r.flips();
+            r.flips_since(since);
         }
     }
     // Repair: split where the output strays farther than 0.9 D (samples spaced D), while the

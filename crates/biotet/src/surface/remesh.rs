@@ -967,9 +967,14 @@ impl<'a> Remesher<'a> {
 
     /// The current edges `(a, b)`, `a < b`, sorted.
     pub fn edges(&self) -> Vec<(u32, u32)> {
+        self.edges_since(0)
+    }
+
+    /// The edges of the triangles changed after clock `since` ([`Self::edges`] for 0).
+    fn edges_since(&self, since: u64) -> Vec<(u32, u32)> {
         let mut e: Vec<(u32, u32)> = Vec::with_capacity(self.tris.len() * 3 / 2);
         for t in 0..self.tris.len() {
-            if self.alive[t] {
+            if self.alive[t] && (since == 0 || self.changed[t] > since) {
                 let tri = self.tris[t];
                 for k in 0..3 {
                     let (a, b) = (tri[k], tri[(k + 1) % 3]);
@@ -1041,9 +1046,18 @@ impl<'a> Remesher<'a> {
 
     /// Flip edges until no flip raises an angle (bounded number of sweeps).
     pub fn flips(&mut self) {
+        self.flips_since(0);
+    }
+
+    /// [`Self::flips`] over the edges of the triangles changed after clock `since` (0: every
+    /// edge), each later sweep over those the sweep before changed: an edge whose two triangles
+    /// stayed was refused and would be again (the clean-up's passes change a few hundred of
+    /// tens of thousands).
+    pub fn flips_since(&mut self, since: u64) {
+        let mut since = since;
         for _ in 0..3 {
-            let before = self.counts.flips;
-            for (a, b) in self.edges() {
+            let (before, start) = (self.counts.flips, self.clock);
+            for (a, b) in self.edges_since(since) {
                 if self.has_edge(a, b) {
                     self.flip(a, b);
                 }
@@ -1051,7 +1065,13 @@ impl<'a> Remesher<'a> {
             if self.counts.flips == before {
                 break;
             }
+            since = start;
         }
+    }
+
+    /// The clock ([`Self::flips_since`]): every change to a triangle ticks it.
+    pub fn clock(&self) -> u64 {
+        self.clock
     }
 
     /// Work on the triangles whose smallest angle is below the target: flip their edges,
