@@ -129,6 +129,11 @@ pub struct Remesher<'a> {
     /// found that flipping it raises no angle (0: never). That depends on the two triangles'
     /// points alone, so while neither changed since, the answer stands without the angles.
     no_flip: Vec<[u64; 3]>,
+    /// Per triangle, the clock when [`Self::clean_up`] last failed on it (0: never), and the
+    /// clean-up mode it failed in: while no triangle at its corners changed since, it is not
+    /// tried again.
+    failed_at: Vec<u64>,
+    failed_middle: bool,
     tri_size: &'a [f64],
     /// Target edge length per point.
     pub size: Vec<f64>,
@@ -195,6 +200,8 @@ impl<'a> Remesher<'a> {
             clock: 0,
             changed: vec![0; s.triangles.len()],
             no_flip: vec![[0; 3]; s.triangles.len()],
+            failed_at: vec![0; s.triangles.len()],
+            failed_middle: false,
             tri_size,
             size: point_size.to_vec(),
             grid,
@@ -554,6 +561,7 @@ impl<'a> Remesher<'a> {
         self.dev.push((f64::INFINITY, 0));
         self.changed.push(0);
         self.no_flip.push([0; 3]);
+        self.failed_at.push(0);
         self.touch(t);
         for &v in &tri {
             self.vt[v as usize].push(t);
@@ -1084,8 +1092,22 @@ impl<'a> Remesher<'a> {
             })
             .collect();
         let mut done = 0;
+        // A new mode (middle collapses) may fix what the last one could not.
+        if self.failed_middle != self.middle {
+            self.failed_middle = self.middle;
+            self.failed_at.fill(0);
+        }
         for t in bad {
             if !self.alive[t as usize] || min_angle_deg(&self.corners(t)) >= self.target_angle {
+                continue;
+            }
+            let around = self.tris[t as usize]
+                .iter()
+                .flat_map(|&v| &self.vt[v as usize])
+                .map(|&u| self.changed[u as usize])
+                .max()
+                .unwrap_or(0);
+            if self.failed_at[t as usize] > around {
                 continue;
             }
             let tri = self.tris[t as usize];
@@ -1123,6 +1145,10 @@ impl<'a> Remesher<'a> {
                 for v in tri {
                     ok |= self.relax(v);
                 }
+            }
+            if !ok {
+                self.clock += 1;
+                self.failed_at[t as usize] = self.clock;
             }
             done += ok as usize;
         }
