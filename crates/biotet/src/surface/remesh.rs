@@ -134,6 +134,9 @@ pub struct Remesher<'a> {
     /// tried again.
     failed_at: Vec<u64>,
     failed_middle: bool,
+    /// Short edges whose collapse the rounds found refused both ways, with the clock then: while
+    /// no triangle at either end changed since, they are not tried again.
+    no_collapse: FxHashMap<(u32, u32), u64>,
     tri_size: &'a [f64],
     /// Target edge length per point.
     pub size: Vec<f64>,
@@ -202,6 +205,7 @@ impl<'a> Remesher<'a> {
             no_flip: vec![[0; 3]; s.triangles.len()],
             failed_at: vec![0; s.triangles.len()],
             failed_middle: false,
+            no_collapse: FxHashMap::default(),
             tri_size,
             size: point_size.to_vec(),
             grid,
@@ -1044,8 +1048,18 @@ impl<'a> Remesher<'a> {
             {
                 continue;
             }
-            if !self.collapse(a, b, hi) {
-                self.collapse(b, a, hi);
+            let around = [a, b]
+                .iter()
+                .flat_map(|&v| &self.vt[v as usize])
+                .map(|&u| self.changed[u as usize])
+                .max()
+                .unwrap_or(0);
+            if self.no_collapse.get(&(a, b)).is_some_and(|&at| at > around) {
+                continue;
+            }
+            if !self.collapse(a, b, hi) && !self.collapse(b, a, hi) {
+                self.clock += 1;
+                self.no_collapse.insert((a, b), self.clock);
             }
         }
         self.flips();
