@@ -212,7 +212,6 @@ fn progress_names_each_step_in_order() {
         "round 2 of 3",
         "round 3 of 3",
         "clean-up",
-        "repair",
         "validating",
         "measuring",
     ];
