@@ -275,39 +275,8 @@ impl Work {
         })
     }
 
-    /// Try to bring `t` (unforced, its smallest angle at or above `thr`, its largest above
-    /// `max_deg`) within range with one new interior point in its face cavity, then in the ring
-    /// of face neighbours around that: an obtuse tet whose corners are all on the surface (two
-    /// of its faces on a ridge of the boundary) has no interior corner to move or remove, and no
-    /// refill of its neighbours' points helps. Accepted as [`Work::insert`] accepts, the measure
-    /// being the range ([`Judge::Range`]).
     #[allow(clippy::too_many_arguments)]
-    pub fn insert_obtuse(
-        &mut self,
-        t: u32,
-        thr: f64,
-        max_deg: f64,
-        searcher: &mut Searcher,
-        rp: &RefillParams,
-        sp: &StepParams,
-        star: &mut Vec<u32>,
-    ) -> Option<Vec<u32>> {
-        let label = self.labels[t as usize];
-        let faces = self.with_face_neighbours(t);
-        self.judge_by = Judge::Range { max_deg };
-        let mut out = self.insert_into(t, faces.clone(), thr, searcher, rp, sp, star);
-        if out.is_none() && self.alive[t as usize] {
-            let ring = self.face_ring(&faces, label);
-            if ring != faces {
-                out = self.insert_into(t, ring, thr, searcher, rp, sp, star);
-            }
-        }
-        self.judge_by = Judge::MinAngle;
-        out
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    fn insert_into(
+    pub(super) fn insert_into(
         &mut self,
         t: u32,
         tets: Vec<u32>,

@@ -4,11 +4,11 @@
 //!
 //! Each, worst first, is refilled with its unforced face neighbours of its label, else an
 //! interior corner's star is refilled without that corner, else one new interior point is put
-//! in its face cavity or the ring around it ([`Work::insert_obtuse`]: a tet with its four corners
-//! on the surface, two faces on a ridge, has nothing else to change); a change is accepted only
-//! when the cavity's worst measure rises, the measure being the smallest angle and, for the
-//! largest, its distance below the cap added to the threshold ([`Judge::Range`]), and no tet
-//! falls below the threshold that was not. Points on the surface never move.
+//! in its face cavity or the ring around it (as polish's insertions are: a tet with its four
+//! corners on the surface, two faces on a ridge, has nothing else to change); a change is
+//! accepted only when the cavity's worst measure rises, the measure being the smallest angle
+//! and, for the largest, its distance below the cap added to the threshold ([`Judge::Range`]),
+//! and no tet falls below the threshold that was not. Points on the surface never move.
 
 use rayon::prelude::*;
 
@@ -62,9 +62,23 @@ pub(super) fn run(
                 break;
             }
         }
-        if !done && let Some(ids) = w.insert_obtuse(t, thr, max_deg, searcher, rp, sp, star) {
-            check.extend(ids);
+        if done {
+            continue;
         }
+        // No interior corner, or none helps (four corners on the surface, two faces on a
+        // shallow ridge): one new interior point in its face cavity, else the ring of face
+        // neighbours around it, accepted as polish's insertions are, by the range.
+        w.judge_by = by;
+        let faces = w.with_face_neighbours(t);
+        let mut got = w.insert_into(t, faces.clone(), thr, searcher, rp, sp, star);
+        if got.is_none() && w.alive[t as usize] {
+            let ring = w.face_ring(&faces, w.labels[t as usize]);
+            if ring != faces {
+                got = w.insert_into(t, ring, thr, searcher, rp, sp, star);
+            }
+        }
+        w.judge_by = Judge::MinAngle;
+        check.extend(got.into_iter().flatten());
     }
     let changed = check.len() > before;
     check.sort_unstable();

@@ -36,7 +36,7 @@ pub(super) struct Work {
     /// Tets whose insertion was refused only for that count (the last pass retries these alone).
     pub rescuable: Vec<u32>,
     /// What an insertion into a cavity ([`Work::insert`]) must raise: the smallest angle, or in
-    /// the obtuse step ([`Work::insert_obtuse`]) the range.
+    /// the obtuse step the range.
     pub judge_by: Judge,
 }
 
