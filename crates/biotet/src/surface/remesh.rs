@@ -986,12 +986,14 @@ impl<'a> Remesher<'a> {
     fn edges_since(&self, since: u64) -> Vec<(u32, u32)> {
         let mut e: Vec<(u32, u32)> = Vec::with_capacity(self.tris.len() * 3 / 2);
         for t in 0..self.tris.len() {
+            // Every edge is listed by the triangle that has it in increasing order; a changed
+            // triangle lists all three of its edges (the one across may not have changed).
             if self.alive[t] && (since == 0 || self.changed[t] > since) {
                 let tri = self.tris[t];
                 for k in 0..3 {
                     let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                    if a < b {
-                        e.push((a, b));
+                    if a < b || since > 0 {
+                        e.push((a.min(b), a.max(b)));
                     }
                 }
             }
