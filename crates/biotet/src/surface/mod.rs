@@ -16,7 +16,7 @@
 //!    ([`hausdorff::one_sided`] both ways); where it finds the output beyond `D`, or cannot
 //!    prove it within, the repair: the output triangles there are refined (the longest edge
 //!    split, the new point projected onto the input) and the output validated and measured
-//!    again (at most [`REPAIRS`] times); the run fails with [`SurfaceError::Tolerance`] if the
+//!    again (at most four times, `REPAIRS`); the run fails with [`SurfaceError::Tolerance`] if the
 //!    distance still exceeds `D`.
 //!
 //! Everything is sequential except the measures (parallel, order-independent), so the output is
