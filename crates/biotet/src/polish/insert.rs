@@ -53,6 +53,7 @@ impl Work {
     ) -> Option<Vec<u32>> {
         let label = self.labels[t as usize];
         let faces = self.with_face_neighbours(t);
+        let by = Judge::MinAngle;
         // A nearly flat tet's last chance (rare: one on wm_20k) starts from two rings of face
         // neighbours: the more room around the new point, the fewer of its tets below the
         // threshold. A randomly turned box whose only fill of its corners has a flat tet got,
@@ -62,12 +63,12 @@ impl Work {
             let ring = self.face_ring(&faces, label);
             let wide = self.face_ring(&ring, label);
             if wide != faces
-                && let Some(ids) = self.insert_into(t, wide, thr, searcher, rp, sp, star)
+                && let Some(ids) = self.insert_into(t, wide, thr, searcher, rp, sp, star, by)
             {
                 return Some(ids);
             }
         }
-        if let Some(ids) = self.insert_into(t, faces.clone(), thr, searcher, rp, sp, star) {
+        if let Some(ids) = self.insert_into(t, faces.clone(), thr, searcher, rp, sp, star, by) {
             return Some(ids);
         }
         // Every tet of the label sharing an edge (two corners) with t.
@@ -89,7 +90,7 @@ impl Work {
         edges.sort_unstable();
         edges.dedup();
         if edges != faces
-            && let Some(ids) = self.insert_into(t, edges.clone(), thr, searcher, rp, sp, star)
+            && let Some(ids) = self.insert_into(t, edges.clone(), thr, searcher, rp, sp, star, by)
         {
             return Some(ids);
         }
@@ -98,7 +99,7 @@ impl Work {
         let ring = self.face_ring(&faces, label);
         if ring != faces
             && ring != edges
-            && let Some(ids) = self.insert_into(t, ring.clone(), thr, searcher, rp, sp, star)
+            && let Some(ids) = self.insert_into(t, ring.clone(), thr, searcher, rp, sp, star, by)
         {
             return Some(ids);
         }
@@ -110,7 +111,7 @@ impl Work {
         if ball == faces || ball == edges || ball == ring {
             return None;
         }
-        self.insert_into(t, ball, thr, searcher, rp, sp, star)
+        self.insert_into(t, ball, thr, searcher, rp, sp, star, by)
     }
 
     /// The unforced tets of `t`'s label whose circumsphere strictly holds `t`'s circumcentre,
@@ -275,6 +276,8 @@ impl Work {
         })
     }
 
+    /// One new interior point in the cavity `tets` around `t`, kept when the cavity's worst
+    /// measure (`by`) rises (see the module documentation); the new tets when kept.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn insert_into(
         &mut self,
@@ -285,6 +288,7 @@ impl Work {
         rp: &RefillParams,
         sp: &StepParams,
         star: &mut Vec<u32>,
+        by: Judge,
     ) -> Option<Vec<u32>> {
         if tets.len() > rp.max_tets {
             return None;
@@ -295,7 +299,7 @@ impl Work {
         let large = tets.len() > 5;
         let (cav, on_shell) = self.cavity_of_shell_points(tets)?;
         let (x, cone_ok) = self.best_point(t, &cav.tets, &cav.shell, thr)?;
-        let old = judge(self, &cav.tets, thr, self.judge_by);
+        let old = judge(self, &cav.tets, thr, by);
         // In the last pass, a flat tet (under a thousandth of the threshold: gmsh's t13 kept two
         // at 3e-15°, a solver's stiffness matrix then singular to round-off) is traded for any
         // fill whose every tet is above a hundredth of it, however many are then below it.
@@ -311,7 +315,7 @@ impl Work {
             let cone: Vec<[u32; 4]> = cav.shell.iter().map(|f| [f[0], f[1], f[2], p]).collect();
             let ids = self.replace(&cav, &cone);
             self.relocate(p, thr.to_radians(), sp, star);
-            let new = judge(self, &ids, thr, self.judge_by);
+            let new = judge(self, &ids, thr, by);
             (ids, new)
         } else {
             (
@@ -343,7 +347,7 @@ impl Work {
                 if let Ok(f) = r {
                     let cur = self.cavity(ids);
                     ids = self.replace(&cur, &f.tets);
-                    new = judge(self, &ids, thr, self.judge_by);
+                    new = judge(self, &ids, thr, by);
                     filled = true;
                     break;
                 }

@@ -68,16 +68,14 @@ pub(super) fn run(
         // No interior corner, or none helps (four corners on the surface, two faces on a
         // shallow ridge): one new interior point in its face cavity, else the ring of face
         // neighbours around it, accepted as polish's insertions are, by the range.
-        w.judge_by = by;
         let faces = w.with_face_neighbours(t);
-        let mut got = w.insert_into(t, faces.clone(), thr, searcher, rp, sp, star);
+        let mut got = w.insert_into(t, faces.clone(), thr, searcher, rp, sp, star, by);
         if got.is_none() && w.alive[t as usize] {
             let ring = w.face_ring(&faces, w.labels[t as usize]);
             if ring != faces {
-                got = w.insert_into(t, ring, thr, searcher, rp, sp, star);
+                got = w.insert_into(t, ring, thr, searcher, rp, sp, star, by);
             }
         }
-        w.judge_by = Judge::MinAngle;
         check.extend(got.into_iter().flatten());
     }
     let changed = check.len() > before;

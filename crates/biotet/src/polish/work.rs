@@ -5,8 +5,6 @@ use crate::mesh::tet::{NO_NEIGHBOR, TET_EDGES, TET_FACES, TetMesh};
 use crate::quality::tet::{dihedral_at, dihedral_yx};
 use crate::quality::tri::min_angle_3d_deg;
 
-use super::refill::Judge;
-
 pub(super) type P3 = [f64; 3];
 
 /// A closed cavity: its tets, the shell (faces pointing into it) with the tet outside each shell
@@ -35,9 +33,6 @@ pub(super) struct Work {
     pub rescue: Rescue,
     /// Tets whose insertion was refused only for that count (the last pass retries these alone).
     pub rescuable: Vec<u32>,
-    /// What an insertion into a cavity ([`Work::insert`]) must raise: the smallest angle, or in
-    /// the obtuse step the range.
-    pub judge_by: Judge,
 }
 
 /// Polish's last passes, each accepting more than the one before (ordered).
@@ -75,7 +70,6 @@ impl Work {
             free: Vec::new(),
             forced_deg,
             rescue: Rescue::Off,
-            judge_by: Judge::MinAngle,
             rescuable: Vec::new(),
         };
         for t in 0..n {

@@ -103,10 +103,17 @@ struct Pre {
     nn: f64,
 }
 
+/// A triangle's bounding box.
+#[inline]
+fn tri_box(t: &[P3; 3]) -> (P3, P3) {
+    let lo = [0, 1, 2].map(|k| t[0][k].min(t[1][k]).min(t[2][k]));
+    let hi = [0, 1, 2].map(|k| t[0][k].max(t[1][k]).max(t[2][k]));
+    (lo, hi)
+}
+
 impl Pre {
     fn new(t: &[P3; 3]) -> Pre {
-        let lo = [0, 1, 2].map(|k| t[0][k].min(t[1][k]).min(t[2][k]));
-        let hi = [0, 1, 2].map(|k| t[0][k].max(t[1][k]).max(t[2][k]));
+        let (lo, hi) = tri_box(t);
         let n = cross(sub(t[1], t[0]), sub(t[2], t[0]));
         Pre {
             lo,
@@ -117,19 +124,32 @@ impl Pre {
     }
 }
 
-/// [`within_d2`] with the rejections' data precomputed.
+/// Whether `p` lies outside the box `lo..hi` grown by `r` (and a relative margin).
 #[inline]
-fn within_d2_pre(p: P3, t: &[P3; 3], pre: &Pre, r: f64, r2: f64) -> Option<f64> {
+fn outside_box(p: P3, lo: P3, hi: P3, r: f64) -> bool {
     let m = r * (1.0 + 1e-9);
-    if (0..3).any(|k| p[k] < pre.lo[k] - m || p[k] > pre.hi[k] + m) {
-        return None;
-    }
-    let h = dot(sub(p, t[0]), pre.n);
-    if h * h > r2 * pre.nn * (1.0 + 1e-9) {
+    (0..3).any(|k| p[k] < lo[k] - m || p[k] > hi[k] + m)
+}
+
+/// [`within_d2`] past its box test: the plane test with the triangle's normal `n` (unnormalized,
+/// `nn` its squared length), then the distance.
+#[inline]
+fn within_d2_plane(p: P3, t: &[P3; 3], n: P3, nn: f64, r2: f64) -> Option<f64> {
+    let h = dot(sub(p, t[0]), n);
+    if h * h > r2 * nn * (1.0 + 1e-9) {
         return None;
     }
     let d2 = dist2(p, closest_on_triangle(p, t));
     (d2 <= r2).then_some(d2)
+}
+
+/// [`within_d2`] with the rejections' data precomputed.
+#[inline]
+fn within_d2_pre(p: P3, t: &[P3; 3], pre: &Pre, r: f64, r2: f64) -> Option<f64> {
+    if outside_box(p, pre.lo, pre.hi, r) {
+        return None;
+    }
+    within_d2_plane(p, t, pre.n, pre.nn, r2)
 }
 
 /// The closest point of triangle `t` to `p` (Voronoi regions of the corners, edges and face,
@@ -197,7 +217,12 @@ pub fn closest_on_triangle(p: P3, t: &[P3; 3]) -> P3 {
 /// deciding a borderline case differently from `dist2(p, closest_on_triangle(p, t)) <= r2`).
 #[inline]
 pub fn within_d2(p: P3, t: &[P3; 3], r: f64, r2: f64) -> Option<f64> {
-    within_d2_pre(p, t, &Pre::new(t), r, r2)
+    let (lo, hi) = tri_box(t);
+    if outside_box(p, lo, hi, r) {
+        return None;
+    }
+    let n = cross(sub(t[1], t[0]), sub(t[2], t[0]));
+    within_d2_plane(p, t, n, dot(n, n), r2)
 }
 
 /// Whether `p` is within `sqrt(r2)` of triangle `t` ([`within_d2`]).

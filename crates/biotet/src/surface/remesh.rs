@@ -1050,12 +1050,7 @@ impl<'a> Remesher<'a> {
             {
                 continue;
             }
-            let around = [a, b]
-                .iter()
-                .flat_map(|&v| &self.vt[v as usize])
-                .map(|&u| self.changed[u as usize])
-                .max()
-                .unwrap_or(0);
+            let around = self.changed_around(&[a, b]);
             if self.no_collapse.get(&(a, b)).is_some_and(|&at| at > around) {
                 continue;
             }
@@ -1098,6 +1093,16 @@ impl<'a> Remesher<'a> {
         self.clock
     }
 
+    /// The latest change to a triangle at any of the points `vs` (0: none since the start): an
+    /// operation refused there before then would be refused again.
+    fn changed_around(&self, vs: &[u32]) -> u64 {
+        vs.iter()
+            .flat_map(|&v| &self.vt[v as usize])
+            .map(|&u| self.changed[u as usize])
+            .max()
+            .unwrap_or(0)
+    }
+
     /// Work on the triangles whose smallest angle is below the target: flip their edges,
     /// collapse their shortest edge, split their longest one, relax their corners.
     pub fn clean_up(&mut self) -> usize {
@@ -1117,13 +1122,7 @@ impl<'a> Remesher<'a> {
             if !self.alive[t as usize] || min_angle_deg(&self.corners(t)) >= self.target_angle {
                 continue;
             }
-            let around = self.tris[t as usize]
-                .iter()
-                .flat_map(|&v| &self.vt[v as usize])
-                .map(|&u| self.changed[u as usize])
-                .max()
-                .unwrap_or(0);
-            if self.failed_at[t as usize] > around {
+            if self.failed_at[t as usize] > self.changed_around(&self.tris[t as usize]) {
                 continue;
             }
             let tri = self.tris[t as usize];
