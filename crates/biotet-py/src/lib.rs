@@ -83,6 +83,7 @@ struct MeshOptions {
     steiner: bool,
     stages: [bool; 4],
     surface_tolerance: Option<f64>,
+    exact_surface: bool,
     surface_feature_angle: f64,
     surface_rounds: usize,
     adaptive_size: bool,
@@ -240,8 +241,12 @@ fn mesh_with(
     // Image labels are the image's values; the template holds small labels.
     let compaction = image.as_ref().map(|_| Compaction::of_surface(&mut surface));
     let frame_to_world = image.as_ref().and_then(|i| i.frame_to_world);
-    // The opt-in surface stage (as `biotet mesh --surface-tolerance D`).
-    let (mut surface, surface_report) = match o.surface_tolerance {
+    // The surface stage (as `biotet mesh --surface-tolerance D`; an image's default).
+    let tolerance = match &image {
+        Some(i) => i.stage_tolerance(o.surface_tolerance, o.exact_surface),
+        None => o.surface_tolerance,
+    };
+    let (mut surface, mut surface_report) = match tolerance {
         None => (surface, None),
         Some(d) => {
             progress("improving the surface");
@@ -326,6 +331,9 @@ fn mesh_with(
     if let Some(c) = &compaction {
         c.restore_tets(&mut mesh);
         c.restore_surface(&mut surface);
+        if let Some(r) = &mut surface_report {
+            c.restore_report(r);
+        }
     }
     if let Some(m) = &frame_to_world {
         // Meshed in the image's frame; a rotation (positive determinant) to world.
@@ -349,7 +357,8 @@ fn mesh_with(
             triangles,
         });
     }
-    let image_regions = image.as_ref().map(|i| i.region_volumes(&quality));
+    let sheets = surface_report.as_ref().map_or(&[][..], |r| &r.sheets[..]);
+    let image_regions = image.as_ref().map(|i| i.region_volumes(&quality, sheets));
     let mut report = json!({
         "input": name,
         "n_surface_triangles": surface.triangles.len(),

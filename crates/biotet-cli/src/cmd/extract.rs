@@ -8,6 +8,7 @@ use biotet::image::labels::LabelOptions;
 pub use biotet::image::surface::ImageSummary;
 use biotet::image::surface::{ImageSurfaceError, RegionVolume, labelled_surface};
 use biotet::quality::QualityReport;
+use biotet::surface::SheetDistance;
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -91,18 +92,23 @@ pub fn surface_from_image(
 
 /// Per region: voxel volume beside the mesh's volume (and its relative error), its tets and
 /// dihedral angle range.
-pub fn region_volumes(summary: &ImageSummary, quality: &QualityReport) -> Vec<RegionVolume> {
-    summary.region_volumes(quality)
+pub fn region_volumes(
+    summary: &ImageSummary,
+    quality: &QualityReport,
+    sheets: &[SheetDistance],
+) -> Vec<RegionVolume> {
+    summary.region_volumes(quality, sheets)
 }
 
 /// Text table of [`region_volumes`].
 pub fn region_text(rows: &[RegionVolume]) -> String {
     let mut t = String::from(
-        "region      voxels   voxel volume    mesh volume     error      tets  dihedral\n",
+        "region      voxels   voxel volume    mesh volume     error      tets  dihedral         \
+         to voxels / back\n",
     );
     for r in rows {
         t += &format!(
-            "{:>6}  {:>10}  {:>13.6e}  {:>13.6e}  {:>+8.1e}  {:>8}  {:.2}°–{:.2}°\n",
+            "{:>6}  {:>10}  {:>13.6e}  {:>13.6e}  {:>+8.1e}  {:>8}  {:.2}°–{:.2}°  {:.3} / {:.3}\n",
             r.label,
             r.voxels,
             r.voxel_volume,
@@ -111,6 +117,8 @@ pub fn region_text(rows: &[RegionVolume]) -> String {
             r.tets,
             r.min_dihedral_deg.unwrap_or(f64::NAN),
             r.max_dihedral_deg.unwrap_or(f64::NAN),
+            r.hausdorff_in_to_out,
+            r.hausdorff_out_to_in,
         );
     }
     t

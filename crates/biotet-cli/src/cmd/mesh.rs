@@ -36,7 +36,12 @@ Examples:
   biotet mesh part.stl -o part.vtu --no-steiner --keep-failed
       No new points at all (the seed's recovery alone). If a triangle then cannot be recovered,
       the run exits 1, part.vtu is neither created nor replaced, and the partial mesh is written
-      to part.failed.vtu for inspection.";
+      to part.failed.vtu for inspection.
+  biotet mesh aseg.mgz -o head.vtu --json
+      A label image: one region per label (the image's values), its voxel faces remeshed within
+      half a voxel first; image_regions gives each region's volume and distance to its voxels.
+  biotet mesh aseg.mgz -o blocks.vtu --exact-surface
+      The voxel faces meshed as they are: every region's volume is its voxel volume.";
 
 /// Arguments of `biotet mesh`.
 #[derive(clap::Args)]
@@ -127,11 +132,18 @@ pub struct Args {
     /// Before node deployment, remesh the surface to well-shaped triangles within this
     /// two-sided (Hausdorff) distance D of the input (see `biotet surface improve --help`); the
     /// improved surface is then kept exactly. The edge length is --size, else the input's
-    /// median edge length. Off by default: the input surface is kept exactly.
+    /// median edge length. Default for a surface: off (kept exactly); for a label image: half
+    /// the smallest voxel spacing (see --exact-surface).
     #[arg(long, value_name = "D")]
     surface_tolerance: Option<f64>,
-    /// Where --surface-tolerance writes the improved surface (.ply keeps the region labels).
-    #[arg(long, value_name = "FILE", requires = "surface_tolerance")]
+    /// Keep the input surface exactly, with no surface stage: for a label image, mesh its voxel
+    /// faces as they are (each region's mesh volume is then its voxel volume, the boundary a
+    /// staircase). A surface input is kept exactly anyway unless --surface-tolerance is given.
+    #[arg(long, conflicts_with = "surface_tolerance")]
+    exact_surface: bool,
+    /// Write the surface that was meshed here (after the surface stage, if it ran; .ply and
+    /// .vtu keep the region labels).
+    #[arg(long, value_name = "FILE")]
     surface_output: Option<PathBuf>,
     #[command(flatten)]
     surface_stage: super::surface::StageArgs,
@@ -217,16 +229,18 @@ pub fn run(a: Args) -> Result<ExitCode> {
     let compaction = image
         .as_ref()
         .map(|_| biotet::image::labels::Compaction::of_surface(&mut surface));
-    // The opt-in surface stage: the improved surface replaces the input from here on.
-    let (mut surface, surface_report) = match a.surface_tolerance {
+    // The surface stage (opt-in for a surface, the default for an image): the improved surface
+    // replaces the input from here on.
+    let tolerance = match &image {
+        Some(i) => i.stage_tolerance(a.surface_tolerance, a.exact_surface),
+        None => a.surface_tolerance,
+    };
+    let (mut surface, mut surface_report) = match tolerance {
         None => (surface, None),
         Some(d) => {
             stage.set("improving the surface");
             let (s, r) = super::surface::stage(&surface, d, a.size, &a.surface_stage, &stage)
                 .with_context(|| name.clone())?;
-            if let Some(path) = &a.surface_output {
-                biotet_io::write_surface(path, &s)?;
-            }
             (s, Some(r))
         }
     };
@@ -313,12 +327,19 @@ pub fn run(a: Args) -> Result<ExitCode> {
     if let Some(c) = &compaction {
         c.restore_tets(&mut mesh);
         c.restore_surface(&mut surface);
+        if let Some(r) = &mut surface_report {
+            c.restore_report(r);
+        }
     }
     if let Some(m) = image.as_ref().and_then(|i| i.frame_to_world.as_ref()) {
         // Meshed in the image's frame; a rotation (positive determinant) to world.
         biotet::image::map_points(m, &mut mesh.points);
         biotet::image::map_points(m, &mut surface.points);
     }
+    if let Some(path) = &a.surface_output {
+        biotet_io::write_surface(path, &surface)?;
+    }
+    let sheets = surface_report.as_ref().map_or(&[][..], |r| &r.sheets[..]);
 
     release_free_memory();
     peaks.next(Some("measuring"));
@@ -401,7 +422,9 @@ pub fn run(a: Args) -> Result<ExitCode> {
                 .collect::<Vec<_>>(),
             "mesh_bytes": mesh.bytes(),
             "image": image,
-            "image_regions": image.as_ref().map(|i| super::extract::region_volumes(i, &quality)),
+            "image_regions": image
+                .as_ref()
+                .map(|i| super::extract::region_volumes(i, &quality, sheets)),
         });
         if let Some(r) = &surface_report {
             v["surface"] = serde_json::to_value(r)?;
@@ -475,8 +498,9 @@ pub fn run(a: Args) -> Result<ExitCode> {
         );
         if let Some(i) = &image {
             text += "\n";
-            text += super::extract::region_text(&super::extract::region_volumes(i, &quality))
-                .trim_end();
+            text +=
+                super::extract::region_text(&super::extract::region_volumes(i, &quality, sheets))
+                    .trim_end();
         }
         crate::emit(&text);
     }

@@ -249,6 +249,7 @@ def _mesh_options(
     surface_tolerance: float | None,
     surface: tuple[float, int, bool],
     size_field: dict | None,
+    exact_surface: bool = False,
 ) -> dict:
     """The options of ``mesh``, ``mesh_image`` and ``mesh_file`` as the native module reads
     them."""
@@ -264,6 +265,7 @@ def _mesh_options(
         steiner=steiner,
         stages=stages,
         surface_tolerance=surface_tolerance,
+        exact_surface=bool(exact_surface),
         surface_feature_angle=float(surface[0]),
         surface_rounds=int(surface[1]),
         adaptive_size=bool(surface[2]),
@@ -471,6 +473,7 @@ def mesh_image(
     smooth: bool = True,
     polish: bool = True,
     surface_tolerance: float | None = None,
+    exact_surface: bool = False,
     surface_feature_angle: float = 30.0,
     surface_rounds: int = 4,
     adaptive_size: bool = False,
@@ -484,9 +487,11 @@ def mesh_image(
     centred at ``origin + spacing * (i, j, k)``, or at ``affine @ (i, j, k, 1)`` when an
     ``affine`` (4×4 or 3×4, voxel to world, e.g. nibabel's ``img.affine``) is given. Each
     non-zero value is a region whose tets keep that value as their label; 0 is the outside.
-    The surface is the voxel faces between labels, kept exactly (an oblique image is meshed in
-    its axis-aligned frame and rotated to world), so each region's mesh volume is its voxel
-    volume.
+    The surface is the voxel faces between labels (an oblique image is meshed in its
+    axis-aligned frame and rotated to world), remeshed by the surface stage within half the
+    smallest voxel spacing unless ``surface_tolerance`` says otherwise; ``exact_surface=True``
+    keeps the voxel faces exactly instead (``--exact-surface``: each region's mesh volume is
+    then its voxel volume, its boundary a staircase).
 
     The label options, as the CLI's: ``keep_labels`` (``--labels``: the others become outside),
     ``merge`` (``--merge``: a mapping from a label to the label it joins, applied first),
@@ -517,7 +522,7 @@ def mesh_image(
         size, grading, min_size, max_size, region_sizes, resolution, zone, max_voxels,
         steiner, (recover, improve, smooth, polish), surface_tolerance,
         (surface_feature_angle, surface_rounds, adaptive_size),
-        _size_field(size_field, size_field_array, m),
+        _size_field(size_field, size_field_array, m), exact_surface,
     )
     return _tet(_call(_core.mesh_image, vol, m, name, img, o, threads, _progress(progress)))
 
@@ -546,6 +551,7 @@ def mesh_file(
     smooth: bool = True,
     polish: bool = True,
     surface_tolerance: float | None = None,
+    exact_surface: bool = False,
     surface_feature_angle: float = 30.0,
     surface_rounds: int = 4,
     adaptive_size: bool = False,
@@ -559,7 +565,9 @@ def mesh_file(
 
     ``labels`` maps a surface file (as given, or its name) to the labels of its shells, as
     ``--label FILE=N,...``. ``keep_labels``, ``merge``, ``outside`` and
-    ``min_component_voxels`` apply to a label image, as in :func:`mesh_image`.
+    ``min_component_voxels`` apply to a label image, as in :func:`mesh_image` (its surface
+    remeshed within half the smallest voxel spacing unless ``surface_tolerance`` is given or
+    ``exact_surface=True``).
 
     Sizes: ``size`` (uniform), else ``size_field`` (a .vti or NIfTI file, with
     ``size_field_array`` naming a .vti array, or a :class:`SizeField`; as ``--size-field``), else
@@ -591,7 +599,7 @@ def mesh_file(
         size, grading, min_size, max_size, region_sizes, resolution, zone, max_voxels,
         steiner, (recover, improve, smooth, polish), surface_tolerance,
         (surface_feature_angle, surface_rounds, adaptive_size),
-        _size_field(size_field, size_field_array),
+        _size_field(size_field, size_field_array), exact_surface,
     )
     return _tet(_call(_core.mesh_files, ps, per_file, img, o, threads, _progress(progress)))
 

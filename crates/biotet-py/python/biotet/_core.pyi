@@ -37,6 +37,7 @@ class _MeshOptions(TypedDict):
     steiner: bool
     stages: tuple[bool, bool, bool, bool]
     surface_tolerance: float | None
+    exact_surface: bool
     surface_feature_angle: float
     surface_rounds: int
     adaptive_size: bool

@@ -312,6 +312,17 @@ impl Compaction {
         }
     }
 
+    /// Put the image's labels back on the surface stage's report (its sheets and regions).
+    pub fn restore_report(&self, r: &mut crate::surface::SurfaceReport) {
+        let back = |l: &mut u32| *l = self.original.get(*l as usize).copied().unwrap_or(*l);
+        for s in r.sheets.iter_mut() {
+            s.sides.iter_mut().for_each(back);
+        }
+        for v in r.regions.iter_mut() {
+            back(&mut v.label);
+        }
+    }
+
     /// Put the image's labels back on a tet mesh.
     pub fn restore_tets(&self, m: &mut crate::TetMesh) {
         for l in m.labels.iter_mut() {

@@ -9,6 +9,7 @@ use super::labels::{Components, LabelError, LabelOptions, LabelReport, apply};
 use crate::SurfaceMesh;
 use crate::mesh::validate::{SurfaceError, ValidateOptions, validate_surface};
 use crate::quality::QualityReport;
+use crate::surface::SheetDistance;
 use std::time::Instant;
 
 /// What applying the labels, extracting and validating an image gave, for the reports.
@@ -29,7 +30,7 @@ pub struct ImageSummary {
     /// to world at the end (see [`LabelImage::to_frame`]). `None`: already axis-aligned.
     pub frame_to_world: Option<[[f64; 4]; 4]>,
     /// The surface stage's default tolerance for this image (half the smallest spacing); the
-    /// surface stage (issue 20) is not applied here.
+    /// stage itself runs after extraction ([`Self::stage_tolerance`]).
     pub default_surface_tolerance: f64,
     /// Labels, islands.
     pub labels: LabelReport,
@@ -82,6 +83,11 @@ pub struct RegionVolume {
     pub min_dihedral_deg: Option<f64>,
     /// Its largest dihedral angle (degrees), `None` without tets.
     pub max_dihedral_deg: Option<f64>,
+    /// The largest distance from its voxel boundary to its mesh boundary, measured sheet by
+    /// sheet by the surface stage (0 when the voxel faces are kept exactly).
+    pub hausdorff_in_to_out: f64,
+    /// The largest distance from its mesh boundary to its voxel boundary.
+    pub hausdorff_out_to_in: f64,
 }
 
 /// Why an image gives no surface to mesh.
@@ -238,14 +244,26 @@ impl ImageSummary {
         t
     }
 
-    /// Per region: voxel volume beside the mesh's volume (and its relative error), its tets
-    /// and dihedral angle range.
-    pub fn region_volumes(&self, quality: &QualityReport) -> Vec<RegionVolume> {
+    /// The surface stage's tolerance when meshing this image: `requested` if given, else none
+    /// when `exact` (the voxel faces kept as they are), else [`Self::default_surface_tolerance`].
+    pub fn stage_tolerance(&self, requested: Option<f64>, exact: bool) -> Option<f64> {
+        requested.or((!exact).then_some(self.default_surface_tolerance))
+    }
+
+    /// Per region: voxel volume beside the mesh's volume (and its relative error), its tets,
+    /// dihedral angle range, and the distances of its boundary to the voxel boundary from the
+    /// stage's `sheets` (in image labels; none when the voxel faces were kept).
+    pub fn region_volumes(
+        &self,
+        quality: &QualityReport,
+        sheets: &[SheetDistance],
+    ) -> Vec<RegionVolume> {
         self.regions
             .iter()
             .map(|r| {
                 let q = quality.regions.iter().find(|q| q.label == r.label);
                 let m = q.map_or(0.0, |q| q.volume);
+                let own = || sheets.iter().filter(|s| s.sides.contains(&r.label));
                 RegionVolume {
                     label: r.label,
                     voxels: r.voxels,
@@ -255,6 +273,8 @@ impl ImageSummary {
                     tets: q.map_or(0, |q| q.n_tets),
                     min_dihedral_deg: q.map(|q| q.min_dihedral_deg),
                     max_dihedral_deg: q.map(|q| q.max_dihedral_deg),
+                    hausdorff_in_to_out: own().map(|s| s.in_to_out).fold(0.0, f64::max),
+                    hausdorff_out_to_in: own().map(|s| s.out_to_in).fold(0.0, f64::max),
                 }
             })
             .collect()

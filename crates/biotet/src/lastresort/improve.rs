@@ -405,6 +405,7 @@ impl View<'_> {
                 Metric::Q => 0.0,
                 Metric::Dihedral => old_worst.max(0.0) * (1.0 + 1e-9),
             },
+            max_dihedral: 180.0,
             max_nodes: self.opts.max_nodes.min(
                 self.opts
                     .nodes_per_tet

@@ -49,7 +49,7 @@ use crate::geom::intersect::{TriTri, is_degenerate, seg_tri, tri_tri};
 use crate::geom::predicates::{Sign, in_exact_range};
 pub(super) use crate::geom::vec3::bbox;
 use crate::geom::vec3::{cross, norm, norm2, sub};
-use crate::quality::tet::{min_dihedral_chord2, q_measure, volume};
+use crate::quality::tet::{max_dihedral_chord2, min_dihedral_chord2, q_measure, volume};
 use rustc_hash::FxHashMap;
 use std::cell::Cell;
 use thiserror::Error;
@@ -66,6 +66,10 @@ pub struct SearchOptions {
     /// below 0: no floor). Sliver removal sets it to the cavity's worst angle, so every fill
     /// found is an improvement and no search is spent on refills that would be rejected.
     pub min_dihedral: f64,
+    /// Candidates need their largest dihedral angle strictly below this many degrees (at or
+    /// above 180: no cap). Polish's obtuse step sets it, so a fill never brings back the
+    /// obtuse tet it replaces.
+    pub max_dihedral: f64,
     /// Node budget for the first fill.
     pub max_nodes: u64,
     /// After the first fill, look for fills with a better worst tet for at most this many more
@@ -78,6 +82,7 @@ impl Default for SearchOptions {
         SearchOptions {
             min_quality: 0.0,
             min_dihedral: 0.0,
+            max_dihedral: 180.0,
             max_nodes: 100_000,
             improve: None,
         }
@@ -259,6 +264,9 @@ pub struct Searcher {
     eta3: f64,
     /// The dihedral floor as [`min_dihedral_chord2`] of it; `None` for no floor.
     floor: Option<f64>,
+    /// The dihedral cap as the chord² of the largest angle (`max_dihedral_chord2`); `None` for
+    /// no cap.
+    cap: Option<f64>,
     improve: Option<u64>,
     scratch: Vec<[u32; 3]>,
     edges: Vec<(u32, u32)>,
@@ -455,6 +463,10 @@ impl Searcher {
         self.eta3 = opts.min_quality.powi(3);
         self.floor = (opts.min_dihedral > 0.0).then(|| {
             let s = (opts.min_dihedral.to_radians() / 2.0).sin();
+            4.0 * s * s
+        });
+        self.cap = (opts.max_dihedral < 180.0).then(|| {
+            let s = (opts.max_dihedral.to_radians() / 2.0).sin();
             4.0 * s * s
         });
         self.improve = opts.improve;
@@ -883,7 +895,10 @@ impl Searcher {
         // The tests are a conjunction, so their order is free: with a float threshold the float
         // tests run first (they reject most apexes, the point behind the face included, and
         // cost less than a first exact orientation); without one, the exact test first.
-        let floats_first = self.eta > 0.0 || self.floor.is_some() || self.bound > f64::NEG_INFINITY;
+        let floats_first = self.eta > 0.0
+            || self.floor.is_some()
+            || self.cap.is_some()
+            || self.bound > f64::NEG_INFINITY;
         'apex: for p in 0..self.pts.len() as u32 {
             if v.contains(&p) || !self.usable(p) {
                 continue;
@@ -902,6 +917,7 @@ impl Searcher {
             if (self.eta > 0.0 && !self.above_eta(q, &corners))
                 || q <= self.bound
                 || self.floor.is_some_and(|f| !dihedrals_above(&corners, f))
+                || self.cap.is_some_and(|c| max_dihedral_chord2(&corners) >= c)
             {
                 continue;
             }

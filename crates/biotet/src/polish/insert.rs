@@ -226,8 +226,12 @@ impl Work {
             if !every_face_has_candidate(&self.pts, &cav.shell, &cands, floor) {
                 continue;
             }
-            let Ok(f) = searcher.fill_carved(&self.pts, &cav.shell, &[p], &rp.options(floor))
-            else {
+            let Ok(f) = searcher.fill_carved(
+                &self.pts,
+                &cav.shell,
+                &[p],
+                &rp.options(floor, Judge::MinAngle, thr),
+            ) else {
                 continue;
             };
             self.vtet.push(NO_NEIGHBOR);
@@ -342,7 +346,7 @@ impl Work {
                 if !every_face_has_candidate(&self.pts, &cav.shell, &cands, floor) {
                     continue;
                 }
-                let so = rp.options(floor);
+                let so = rp.options(floor, by, thr);
                 let r = searcher.fill_carved(&self.pts, &cav.shell, &[p], &so);
                 if let Ok(f) = r {
                     let cur = self.cavity(ids);

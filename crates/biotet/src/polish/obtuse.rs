@@ -4,7 +4,8 @@
 //!
 //! Each, worst first, is refilled with its unforced face neighbours of its label, else an
 //! interior corner's star is refilled without that corner, else one new interior point is put
-//! in its face cavity or the ring around it (as polish's insertions are: a tet with its four
+//! in its face cavity, the ring around it or the ring around that (as polish's insertions are,
+//! with fills searched for tets inside the range only: a tet with its four
 //! corners on the surface, two faces on a ridge, has nothing else to change); a change is
 //! accepted only when the cavity's worst measure rises, the measure being the smallest angle
 //! and, for the largest, its distance below the cap added to the threshold ([`Judge::Range`]),
@@ -71,9 +72,16 @@ pub(super) fn run(
         let faces = w.with_face_neighbours(t);
         let mut got = w.insert_into(t, faces.clone(), thr, searcher, rp, sp, star, by);
         if got.is_none() && w.alive[t as usize] {
-            let ring = w.face_ring(&faces, w.labels[t as usize]);
-            if ring != faces {
-                got = w.insert_into(t, ring, thr, searcher, rp, sp, star, by);
+            // The ring, then the ring around it (an interface ridge on the MNI brain image
+            // left one at 165.5° that only the second ring's point fixes).
+            let mut inner = faces;
+            for _ in 0..2 {
+                let ring = w.face_ring(&inner, w.labels[t as usize]);
+                if ring == inner || got.is_some() || !w.alive[t as usize] {
+                    break;
+                }
+                got = w.insert_into(t, ring.clone(), thr, searcher, rp, sp, star, by);
+                inner = ring;
             }
         }
         check.extend(got.into_iter().flatten());

@@ -26,11 +26,17 @@ pub(super) struct RefillParams {
 }
 
 impl RefillParams {
-    /// The search's options for fills whose every tet is above `floor` degrees.
-    pub fn options(&self, floor: f64) -> SearchOptions {
+    /// The search's options for fills whose every tet measures above `floor` degrees by `by`
+    /// (for [`Judge::Range`], a largest angle below the cap less what `floor` lacks of the
+    /// threshold `thr`).
+    pub(super) fn options(&self, floor: f64, by: Judge, thr: f64) -> SearchOptions {
         SearchOptions {
             min_quality: 0.0,
             min_dihedral: floor,
+            max_dihedral: match by {
+                Judge::MinAngle => 180.0,
+                Judge::Range { max_deg } => max_deg + (thr - floor).max(0.0),
+            },
             max_nodes: self.max_nodes,
             improve: Some(self.improve_nodes),
         }
@@ -165,7 +171,7 @@ impl Work {
             if !every_face_has_candidate(&self.pts, &cav.shell, &cands, floor) {
                 continue;
             }
-            let so = p.options(floor);
+            let so = p.options(floor, by, thr);
             if let Ok(f) = searcher.fill_carved(&self.pts, &cav.shell, &inner, &so) {
                 fill = Some(f);
                 break;

@@ -220,6 +220,63 @@ fn search_improves_worst_quality() {
 }
 
 #[test]
+fn search_dihedral_cap_bounds_every_tet() {
+    // The cube with an inner point: the fills differ in their largest angle.
+    let (mut pts, shell) = cube();
+    pts.push([0.3, 0.6, 0.45]);
+    let max_dihedral = |t: &[u32; 4]| {
+        let a = biotet::quality::tet::dihedral_angles(&t.map(|i| pts[i as usize]));
+        a.iter().copied().fold(0.0, f64::max).to_degrees()
+    };
+    let worst = |tets: &[[u32; 4]]| tets.iter().map(max_dihedral).fold(0.0, f64::max);
+    let all = SearchOptions {
+        improve: Some(1_000_000),
+        ..SearchOptions::default()
+    };
+    let some = fill(&pts, &shell, &[8], &all).unwrap();
+    let loose = worst(&some.tets);
+    // A cap just under this fill's largest angle excludes it; the fill found then stays under.
+    let cap = loose - 1e-6;
+    match fill(
+        &pts,
+        &shell,
+        &[8],
+        &SearchOptions {
+            max_dihedral: cap,
+            ..all
+        },
+    ) {
+        Ok(f) => {
+            assert_fills(&pts, &shell, &[8], &f.tets);
+            assert!(worst(&f.tets) < cap, "{} vs cap {cap}", worst(&f.tets));
+        }
+        Err(e) => assert!(matches!(e, SearchError::NoFill { .. }), "{e}"),
+    }
+    // At or above 180°: no cap, the same fill as without the field.
+    let same = fill(
+        &pts,
+        &shell,
+        &[8],
+        &SearchOptions {
+            max_dihedral: 180.0,
+            ..all
+        },
+    )
+    .unwrap();
+    assert_eq!(same.tets, some.tets);
+    // A tet's six dihedral angles sum to more than 360°, so one is above 60°: a cap of 60°
+    // leaves no candidate at all.
+    let none = SearchOptions {
+        max_dihedral: 60.0,
+        ..all
+    };
+    assert!(matches!(
+        fill(&pts, &shell, &[8], &none),
+        Err(SearchError::NoFill { .. })
+    ));
+}
+
+#[test]
 fn search_dihedral_floor_bounds_every_tet() {
     // The cube with an inner point: a floor just under the best fill's worst angle keeps a fill,
     // every tet of it above the floor; a floor at that angle leaves none.

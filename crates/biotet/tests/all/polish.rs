@@ -363,3 +363,43 @@ fn polish_splits_an_obtuse_tet_on_a_surface_ridge_with_a_point() {
     let c = check(&m, Some(&s));
     assert!(c.valid, "{c}");
 }
+
+/// A 40³ crop of the MNI brain image (`tests/data/mni_brain_ridge_40.nii.gz`, around (43, −73.5,
+/// 25) mm) through the surface stage at half a voxel, as `biotet mesh IMAGE` does by default:
+/// the grey/white interface there folds over a voxel ridge, and polishing kept one tet at 165.51°
+/// with its four corners on the interface. The obtuse step's fills now keep every tet under the
+/// cap, and its point may go in a second ring of neighbours: every tet within 10°–165°.
+#[test]
+fn polish_keeps_an_image_interface_ridge_within_the_range() {
+    use biotet::image::labels::LabelOptions;
+    use biotet::image::surface::labelled_surface;
+    use biotet::pipeline::{PipelineOptions, mesh_surface};
+    use biotet::surface::{SurfaceOptions, improve};
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../tests/data/mni_brain_ridge_40.nii.gz"
+    );
+    let img = biotet_io::read_label_image(std::path::Path::new(path)).expect("reads");
+    let (voxels, summary) =
+        labelled_surface(img, &LabelOptions::default(), path, &mut |_| {}).expect("extracts");
+    let opts = SurfaceOptions {
+        tolerance: summary.default_surface_tolerance,
+        ..Default::default()
+    };
+    let (s, _) = improve(&voxels, &opts).expect("improves");
+    let sizing = crate::common::default_sizing(&s);
+    let (m, report) =
+        mesh_surface(&s, sizing, &PipelineOptions::default(), &mut |_| {}).expect("meshes");
+    let p = report.polish.expect("polished");
+    assert!(p.n_obtuse_before > 0 && p.n_obtuse_after == 0, "{p:?}");
+    for t in 0..m.tets.len() {
+        let a = dihedral_angles(&m.corners(t)).map(f64::to_degrees);
+        let (lo, hi) = (
+            a.iter().copied().fold(180.0, f64::min),
+            a.iter().copied().fold(0.0, f64::max),
+        );
+        assert!(lo >= 10.0 && hi <= 165.0, "tet {t}: {lo}°, {hi}°");
+    }
+    let c = check(&m, Some(&s));
+    assert!(c.valid, "{c}");
+}
