@@ -157,6 +157,9 @@ fn an_image_is_meshed_through_the_surface_stage_by_default() {
         moved |= a > 0.0;
         let e = row["relative_error"].as_f64().unwrap();
         assert!(e.abs() < 0.2, "{row}");
+        // No region pinched off or lost: as many pieces in the mesh as in the image.
+        assert_eq!(row["components"], row["components_voxels"], "{row}");
+        assert!(row["components"].as_u64().unwrap() >= 1, "{row}");
     }
     assert!(moved, "the stage moved no region's boundary");
     // The mesh keeps the improved surface it wrote, with the image's labels.

@@ -358,7 +358,9 @@ fn mesh_with(
         });
     }
     let sheets = surface_report.as_ref().map_or(&[][..], |r| &r.sheets[..]);
-    let image_regions = image.as_ref().map(|i| i.region_volumes(&quality, sheets));
+    let image_regions = image
+        .as_ref()
+        .map(|i| i.region_volumes(&mesh, &quality, sheets));
     let mut report = json!({
         "input": name,
         "n_surface_triangles": surface.triangles.len(),

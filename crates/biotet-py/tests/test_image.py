@@ -63,6 +63,7 @@ def test_by_default_the_voxel_faces_are_remeshed_within_half_a_voxel():
     for r in rows.values():
         assert 0.0 < r["hausdorff_in_to_out"] <= d and 0.0 < r["hausdorff_out_to_in"] <= d, r
         assert abs(r["relative_error"]) < 0.05, r
+        assert r["components"] == r["components_voxels"] == 1, r
     assert {tuple(sorted(x["sides"])) for x in m.report["surface"]["sheets"]} == {(0, 7), (7, 30)}
     c = biotet.check(m)
     assert c["valid"], c["problems"]

@@ -3,12 +3,12 @@
 
 use crate::{Common, progress::Stage};
 use anyhow::{Context, Result, bail};
-use biotet::SurfaceMesh;
 use biotet::image::labels::LabelOptions;
 pub use biotet::image::surface::ImageSummary;
 use biotet::image::surface::{ImageSurfaceError, RegionVolume, labelled_surface};
 use biotet::quality::QualityReport;
 use biotet::surface::SheetDistance;
+use biotet::{SurfaceMesh, TetMesh};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -94,10 +94,11 @@ pub fn surface_from_image(
 /// dihedral angle range.
 pub fn region_volumes(
     summary: &ImageSummary,
+    mesh: &TetMesh,
     quality: &QualityReport,
     sheets: &[SheetDistance],
 ) -> Vec<RegionVolume> {
-    summary.region_volumes(quality, sheets)
+    summary.region_volumes(mesh, quality, sheets)
 }
 
 /// Text table of [`region_volumes`].
@@ -120,6 +121,15 @@ pub fn region_text(rows: &[RegionVolume]) -> String {
             r.hausdorff_in_to_out,
             r.hausdorff_out_to_in,
         );
+    }
+    for r in rows {
+        if r.components != r.components_voxels {
+            t += &format!(
+                "warning: region {} ({} voxels) has {} connected components in the mesh, {} in \
+                 its voxels\n",
+                r.label, r.voxels, r.components, r.components_voxels
+            );
+        }
     }
     t
 }

@@ -424,7 +424,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
             "image": image,
             "image_regions": image
                 .as_ref()
-                .map(|i| super::extract::region_volumes(i, &quality, sheets)),
+                .map(|i| super::extract::region_volumes(i, &mesh, &quality, sheets)),
         });
         if let Some(r) = &surface_report {
             v["surface"] = serde_json::to_value(r)?;
@@ -498,9 +498,10 @@ pub fn run(a: Args) -> Result<ExitCode> {
         );
         if let Some(i) = &image {
             text += "\n";
-            text +=
-                super::extract::region_text(&super::extract::region_volumes(i, &quality, sheets))
-                    .trim_end();
+            text += super::extract::region_text(&super::extract::region_volumes(
+                i, &mesh, &quality, sheets,
+            ))
+            .trim_end();
         }
         crate::emit(&text);
     }

@@ -6,10 +6,10 @@
 use super::LabelImage;
 use super::extract::{ExtractReport, extract};
 use super::labels::{Components, LabelError, LabelOptions, LabelReport, apply};
-use crate::SurfaceMesh;
 use crate::mesh::validate::{SurfaceError, ValidateOptions, validate_surface};
 use crate::quality::QualityReport;
 use crate::surface::SheetDistance;
+use crate::{SurfaceMesh, TetMesh};
 use std::time::Instant;
 
 /// What applying the labels, extracting and validating an image gave, for the reports.
@@ -83,6 +83,12 @@ pub struct RegionVolume {
     pub min_dihedral_deg: Option<f64>,
     /// Its largest dihedral angle (degrees), `None` without tets.
     pub max_dihedral_deg: Option<f64>,
+    /// Its tets' connected components (through shared faces), beside `components_voxels`: a
+    /// region the surface stage pinched off or the mesher lost shows here.
+    pub components: usize,
+    /// Its voxels' 6-connected components after the manifold repair
+    /// ([`RegionVoxels::components`]: what the extracted surface encloses).
+    pub components_voxels: usize,
     /// The largest distance from its voxel boundary to its mesh boundary, measured sheet by
     /// sheet by the surface stage (0 when the voxel faces are kept exactly).
     pub hausdorff_in_to_out: f64,
@@ -255,9 +261,11 @@ impl ImageSummary {
     /// stage's `sheets` (in image labels; none when the voxel faces were kept).
     pub fn region_volumes(
         &self,
+        mesh: &TetMesh,
         quality: &QualityReport,
         sheets: &[SheetDistance],
     ) -> Vec<RegionVolume> {
+        let comps = mesh.region_components();
         self.regions
             .iter()
             .map(|r| {
@@ -273,6 +281,10 @@ impl ImageSummary {
                     tets: q.map_or(0, |q| q.n_tets),
                     min_dihedral_deg: q.map(|q| q.min_dihedral_deg),
                     max_dihedral_deg: q.map(|q| q.max_dihedral_deg),
+                    components: comps
+                        .binary_search_by_key(&r.label, |c| c.0)
+                        .map_or(0, |i| comps[i].1),
+                    components_voxels: r.components,
                     hausdorff_in_to_out: own().map(|s| s.in_to_out).fold(0.0, f64::max),
                     hausdorff_out_to_in: own().map(|s| s.out_to_in).fold(0.0, f64::max),
                 }

@@ -110,6 +110,50 @@ impl TetMesh {
         over
     }
 
+    /// Each region's connected components (its tets joined through shared faces), as
+    /// `(label, components)` sorted by label. Uses [`TetMesh::neighbors`] when it is in step
+    /// with the tets, else computes the adjacency.
+    pub fn region_components(&self) -> Vec<(u32, usize)> {
+        let rebuilt;
+        let nb = if self.neighbors.len() == self.tets.len() {
+            &self.neighbors
+        } else {
+            rebuilt = face_adjacency(&self.tets).0;
+            &rebuilt
+        };
+        let n = self.tets.len();
+        let mut parent: Vec<u32> = (0..n as u32).collect();
+        fn root(parent: &mut [u32], mut x: u32) -> u32 {
+            while parent[x as usize] != x {
+                let up = parent[parent[x as usize] as usize];
+                parent[x as usize] = up;
+                x = up;
+            }
+            x
+        }
+        let label = |t: usize| self.labels.get(t).copied().unwrap_or(0);
+        for (t, across) in nb.iter().enumerate().take(n) {
+            for &u in across {
+                if u != NO_NEIGHBOR && (u as usize) < n && label(u as usize) == label(t) {
+                    let (a, b) = (root(&mut parent, t as u32), root(&mut parent, u));
+                    if a != b {
+                        parent[a.max(b) as usize] = a.min(b);
+                    }
+                }
+            }
+        }
+        let mut count: Vec<(u32, usize)> = Vec::new();
+        for t in 0..n {
+            if root(&mut parent, t as u32) == t as u32 {
+                match count.binary_search_by_key(&label(t), |c| c.0) {
+                    Ok(i) => count[i].1 += 1,
+                    Err(i) => count.insert(i, (label(t), 1)),
+                }
+            }
+        }
+        count
+    }
+
     /// Boundary faces (no tet across), each as `(tet, local face)`.
     pub fn boundary_faces(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
         self.neighbors.iter().enumerate().flat_map(|(t, nb)| {

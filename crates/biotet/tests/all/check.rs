@@ -354,3 +354,34 @@ fn touching_is_judged_per_region_not_per_piece() {
         "{p}"
     );
 }
+
+#[test]
+fn region_components_count_face_connected_tets_of_one_label() {
+    // Four tets around the edge 0–1, each sharing a face with the next (an open fan): labels 1,
+    // 1, 2, 1. Label 1 is then two pieces (the 2 cuts the fan), label 2 one; without the stored
+    // adjacency the count is the same.
+    let points = vec![
+        [0.0, 0.0, -1.0],
+        [0.0, 0.0, 1.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [0.9, -0.4, 0.0],
+    ];
+    let tets = vec![[0, 1, 2, 3], [0, 1, 3, 4], [0, 1, 4, 5], [0, 1, 5, 6]];
+    let mut m = TetMesh::new(points, tets, vec![1, 1, 2, 1]);
+    let shared = m
+        .neighbors
+        .iter()
+        .flatten()
+        .filter(|&&n| n != NO_NEIGHBOR)
+        .count();
+    assert_eq!(shared, 6, "three shared faces, each seen from both tets");
+    assert_eq!(m.region_components(), vec![(1, 2), (2, 1)]);
+    m.labels = vec![1, 1, 1, 1];
+    assert_eq!(m.region_components(), vec![(1, 1)]);
+    m.neighbors.clear();
+    m.labels = vec![1, 2, 1, 2];
+    assert_eq!(m.region_components(), vec![(1, 2), (2, 2)]);
+}
