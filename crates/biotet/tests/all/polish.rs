@@ -339,7 +339,6 @@ fn polish_rescues_the_flattest_tet_of_a_cad_stl() {
 /// 10°–165°, the goal of the surface stage.
 #[test]
 fn polish_splits_an_obtuse_tet_on_a_surface_ridge_with_a_point() {
-    use biotet::pipeline::{PipelineOptions, mesh_surface};
     use biotet::surface::{SurfaceOptions, improve};
     let input = load_stl("wm_20k.stl");
     let opts = SurfaceOptions {
@@ -347,9 +346,16 @@ fn polish_splits_an_obtuse_tet_on_a_surface_ridge_with_a_point() {
         ..Default::default()
     };
     let (s, _) = improve(&input, &opts).expect("improves");
-    let sizing = crate::common::default_sizing(&s);
+    mesh_within_the_range(&s);
+}
+
+/// Mesh `s` with the defaults and assert that polish's obtuse step had work and left none:
+/// every tet within 10°–165°, the mesh valid and keeping `s`.
+fn mesh_within_the_range(s: &SurfaceMesh) {
+    use biotet::pipeline::{PipelineOptions, mesh_surface};
+    let sizing = crate::common::default_sizing(s);
     let (m, report) =
-        mesh_surface(&s, sizing, &PipelineOptions::default(), &mut |_| {}).expect("meshes");
+        mesh_surface(s, sizing, &PipelineOptions::default(), &mut |_| {}).expect("meshes");
     let p = report.polish.expect("polished");
     assert!(p.n_obtuse_before > 0 && p.n_obtuse_after == 0, "{p:?}");
     for t in 0..m.tets.len() {
@@ -360,7 +366,7 @@ fn polish_splits_an_obtuse_tet_on_a_surface_ridge_with_a_point() {
         );
         assert!(lo >= 10.0 && hi <= 165.0, "tet {t}: {lo}°, {hi}°");
     }
-    let c = check(&m, Some(&s));
+    let c = check(&m, Some(s));
     assert!(c.valid, "{c}");
 }
 
@@ -373,7 +379,6 @@ fn polish_splits_an_obtuse_tet_on_a_surface_ridge_with_a_point() {
 fn polish_keeps_an_image_interface_ridge_within_the_range() {
     use biotet::image::labels::LabelOptions;
     use biotet::image::surface::labelled_surface;
-    use biotet::pipeline::{PipelineOptions, mesh_surface};
     use biotet::surface::{SurfaceOptions, improve};
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
@@ -387,19 +392,5 @@ fn polish_keeps_an_image_interface_ridge_within_the_range() {
         ..Default::default()
     };
     let (s, _) = improve(&voxels, &opts).expect("improves");
-    let sizing = crate::common::default_sizing(&s);
-    let (m, report) =
-        mesh_surface(&s, sizing, &PipelineOptions::default(), &mut |_| {}).expect("meshes");
-    let p = report.polish.expect("polished");
-    assert!(p.n_obtuse_before > 0 && p.n_obtuse_after == 0, "{p:?}");
-    for t in 0..m.tets.len() {
-        let a = dihedral_angles(&m.corners(t)).map(f64::to_degrees);
-        let (lo, hi) = (
-            a.iter().copied().fold(180.0, f64::min),
-            a.iter().copied().fold(0.0, f64::max),
-        );
-        assert!(lo >= 10.0 && hi <= 165.0, "tet {t}: {lo}°, {hi}°");
-    }
-    let c = check(&m, Some(&s));
-    assert!(c.valid, "{c}");
+    mesh_within_the_range(&s);
 }
