@@ -8,8 +8,8 @@
 //! an active face `abc` is a tet `abcp` whose fourth point `p` is a cavity point with
 //! 1. `orient3d(a, b, c, p) > 0` (exact);
 //! 2. quality `q` (eq. 4.9) above the threshold ηe and, optionally, smallest dihedral angle
-//!    above a floor (floating point: ranking only; with ηe ≤ 0 and no floor no float test is
-//!    made at all);
+//!    above a floor and largest below a cap (floating point: ranking only; with ηe ≤ 0, no
+//!    floor and no cap no float test is made at all);
 //! 3. no other live cavity point in the closed tet (exact, orient3d);
 //! 4. no improper contact with any other active face: for every active face and every face of
 //!    the tet, the exact triangle–triangle test ([`tri_tri`]) reports disjoint, a shared vertex
