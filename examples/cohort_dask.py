@@ -33,7 +33,8 @@ import biotet
 
 SUMMARY_FIELDS = [
     "subject", "status", "seconds", "points", "tets", "min_dihedral_deg", "max_dihedral_deg",
-    "tets_under_10deg", "steiner_points", "max_region_volume_error", "mesh", "report", "error",
+    "tets_under_10deg", "steiner_points", "max_region_volume_error", "max_region_distance", "mesh",
+    "report", "error",
 ]
 
 
@@ -77,6 +78,13 @@ def mesh_one(path: str, out_dir: str, options: dict) -> dict:
         max_region_volume_error=max(
             (abs(r["relative_error"]) for r in m.report.get("image_regions") or []
              if r["relative_error"] is not None),
+            default="",
+        ),
+        # And the largest distance between a region's boundary and its voxel boundary (either
+        # way; at most half a voxel with the default surface stage).
+        max_region_distance=max(
+            (max(r["hausdorff_in_to_out"], r["hausdorff_out_to_in"])
+             for r in m.report.get("image_regions") or []),
             default="",
         ),
         mesh=str(mesh_path),

@@ -2,6 +2,7 @@
 surface) with a 2-process LocalCluster."""
 
 import csv
+import json
 import subprocess
 import sys
 
@@ -36,9 +37,15 @@ def test_cohort_example_meshes_each_subject_and_reports_failures(tmp_path):
         assert biotet.check(m)["valid"]
         assert (out / f"{name}.json").is_file()
     assert biotet.check(biotet.read(out / "tm_box.vtu"), biotet.read_surface(SHAPES / "tm_box.off"))["valid"]
-    # The image's regions keep its labels and their voxel volumes.
+    # The image's regions keep its labels; their boundaries moved, within half the smallest
+    # voxel spacing of the voxel faces (the surface stage's default), so their volumes moved a
+    # little (a few voxels each in this 5 × 4 × 3 image: several percent).
     image = biotet.read(out / "label_uint8.vtu")
     assert set(image.labels.tolist()) == {1, 2, 17, 41}
-    assert float(rows["label_uint8"]["max_region_volume_error"]) < 1e-9
+    report = json.loads((out / "label_uint8.json").read_text())
+    d = report["image"]["default_surface_tolerance"]
+    assert 0.0 < float(rows["label_uint8"]["max_region_distance"]) <= d
+    assert 0.0 < float(rows["label_uint8"]["max_region_volume_error"]) < 0.2
     assert rows["tm_box"]["max_region_volume_error"] == ""
+    assert rows["tm_box"]["max_region_distance"] == ""
     assert not (out / "invalid_open_box.vtu").exists()
