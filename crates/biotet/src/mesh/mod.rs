@@ -5,6 +5,7 @@
 //! All three are flat arrays with `u32` indices, cheap to hand to numpy, VTK or a solver.
 
 pub mod cavity;
+pub(crate) mod dsu;
 pub mod inside;
 pub mod pslg;
 pub mod shells;

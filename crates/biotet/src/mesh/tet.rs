@@ -122,29 +122,18 @@ impl TetMesh {
             &rebuilt
         };
         let n = self.tets.len();
-        let mut parent: Vec<u32> = (0..n as u32).collect();
-        fn root(parent: &mut [u32], mut x: u32) -> u32 {
-            while parent[x as usize] != x {
-                let up = parent[parent[x as usize] as usize];
-                parent[x as usize] = up;
-                x = up;
-            }
-            x
-        }
+        let mut sets = super::dsu::Dsu::new(n);
         let label = |t: usize| self.labels.get(t).copied().unwrap_or(0);
         for (t, across) in nb.iter().enumerate().take(n) {
             for &u in across {
                 if u != NO_NEIGHBOR && (u as usize) < n && label(u as usize) == label(t) {
-                    let (a, b) = (root(&mut parent, t as u32), root(&mut parent, u));
-                    if a != b {
-                        parent[a.max(b) as usize] = a.min(b);
-                    }
+                    sets.union(t as u32, u);
                 }
             }
         }
         let mut count: Vec<(u32, usize)> = Vec::new();
         for t in 0..n {
-            if root(&mut parent, t as u32) == t as u32 {
+            if sets.find(t as u32) == t as u32 {
                 match count.binary_search_by_key(&label(t), |c| c.0) {
                     Ok(i) => count[i].1 += 1,
                     Err(i) => count.insert(i, (label(t), 1)),

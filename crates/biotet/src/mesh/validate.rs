@@ -64,6 +64,7 @@ use std::fmt;
 use rayon::prelude::*;
 
 use crate::geom::intersect::{SegPart, SegTri, TriTri, is_degenerate, seg_tri, tri_tri};
+use crate::mesh::dsu::Dsu;
 use crate::mesh::surface::SurfaceMesh;
 
 type P3 = [f64; 3];
@@ -664,32 +665,6 @@ impl SurfaceError {
 // -------------------------------------------------------------------------------------------
 // Small helpers
 // -------------------------------------------------------------------------------------------
-
-/// Union–find with the smaller index as root (deterministic).
-struct Dsu(Vec<u32>);
-
-impl Dsu {
-    fn new(n: usize) -> Dsu {
-        Dsu((0..n as u32).collect())
-    }
-
-    fn find(&mut self, mut x: u32) -> u32 {
-        while self.0[x as usize] != x {
-            let p = self.0[x as usize];
-            self.0[x as usize] = self.0[p as usize];
-            x = p;
-        }
-        x
-    }
-
-    fn union(&mut self, a: u32, b: u32) {
-        let (ra, rb) = (self.find(a), self.find(b));
-        if ra != rb {
-            let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
-            self.0[hi as usize] = lo;
-        }
-    }
-}
 
 fn tri_box(c: &[P3; 3]) -> Aabb {
     let mut b = [c[0], c[0]];

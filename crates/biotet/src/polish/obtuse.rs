@@ -67,7 +67,7 @@ pub(super) fn run(
             continue;
         }
         // No interior corner, or none helps (four corners on the surface, two faces on a
-        // shallow ridge): one new interior point in its face cavity, else the ring of face
+        // shallow ridge): one new interior point in its face cavity, else the rings of face
         // neighbours around it, accepted as polish's insertions are, by the range.
         let faces = w.with_face_neighbours(t);
         let mut got = w.insert_into(t, faces.clone(), thr, searcher, rp, sp, star, by);
