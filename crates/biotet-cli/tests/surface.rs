@@ -80,6 +80,8 @@ fn surface_improve_keeps_the_tolerance_and_raises_the_angles() {
         "regions",
         "min_angle_in",
         "min_angle_out",
+        "min_fold_in",
+        "min_fold_out",
         "triangles_in",
         "triangles_out",
         "seconds",

@@ -144,7 +144,9 @@ pub fn report_text(r: &SurfaceReport) -> String {
         "surface: {} → {} triangles in {:.3} s (edge length {:.4}, tolerance {})\n\
          \x20 Hausdorff input→output {:.4}, output→input {:.4} (bound {:.4}, {} samples)\n\
          \x20 triangle angles: min {:.2}° → {:.2}°, max {:.2}° → {:.2}°; under {}°: {} → {} \
-         ({} at kept features)\n",
+         ({} at kept features)\n\
+         \x20 folds (dihedral angle inside at an edge): min {:.2}° → {:.2}° ({} points moved to \
+         open them)\n",
         r.triangles_in,
         r.triangles_out,
         r.seconds,
@@ -162,6 +164,9 @@ pub fn report_text(r: &SurfaceReport) -> String {
         r.n_below_target_in,
         r.n_below_target_out,
         r.n_below_target_at_features,
+        r.min_fold_in,
+        r.min_fold_out,
+        r.n_fold_moves,
     );
     for v in &r.regions {
         t += &format!(

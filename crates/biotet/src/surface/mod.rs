@@ -147,6 +147,13 @@ pub struct SurfaceReport {
     pub n_below_target_out: usize,
     /// Output triangles under the target angle with a corner on a kept feature.
     pub n_below_target_at_features: usize,
+    /// Smallest fold of the input: the interior dihedral angle at an edge, on each meshed side
+    /// (degrees; no tet at that edge can have a larger dihedral angle there).
+    pub min_fold_in: f64,
+    /// Smallest fold of the output.
+    pub min_fold_out: f64,
+    /// Points moved to open folds under 15° that the triangles' own angles do not show.
+    pub n_fold_moves: usize,
     /// Feature edges kept for their dihedral angle.
     pub n_sharp_edges: usize,
     /// Feature edges kept as interface rims, triple lines or touching edges.
@@ -347,6 +354,9 @@ pub fn improve_with_progress(
             r.flips_since(since);
         }
     }
+    // Folds the triangles' own angles do not see (a thin finger's flat tip) force tets as
+    // sharp as they are.
+    let folds_opened = r.open_folds();
     // Validate and measure; where the dense measure finds the output beyond D or cannot prove
     // it within, split there and project (the repair), validate and measure again, a bounded
     // number of times. (A coarser repair pass before it, splitting wherever a sample was beyond
@@ -461,6 +471,9 @@ pub fn improve_with_progress(
         n_below_target_in: below_in,
         n_below_target_out: below_out,
         n_below_target_at_features: at_features,
+        min_fold_in: remesh::min_fold(surface),
+        min_fold_out: remesh::min_fold(&out),
+        n_fold_moves: folds_opened,
         n_sharp_edges: f.n_sharp,
         n_rim_edges: f.n_rim,
         ops: r.counts,
@@ -526,16 +539,17 @@ fn refine_where_far(
     io: &hausdorff::Sided,
     id: impl Fn(u32) -> u32,
 ) {
-    let mut targets: Vec<u32> = oi
-        .far
-        .iter()
-        .map(|x| id(x.triangle))
-        .chain(io.far.iter().map(|x| id(x.nearest)))
-        .collect();
+    let mut targets: Vec<u32> = oi.far.iter().map(|x| id(x.triangle)).collect();
     targets.sort_unstable();
     targets.dedup();
     for t in targets {
         r.refine_triangle(t);
+    }
+    // An input point too far from the output: a point of the output goes there. (Splitting the
+    // nearest triangle and projecting its midpoint can miss it round after round: at a pinch
+    // of the input the projection lands on the other side of the pinch.)
+    for x in &io.far {
+        r.refine_toward(id(x.nearest), x.point);
     }
 }
 

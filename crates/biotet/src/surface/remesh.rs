@@ -26,7 +26,10 @@
 
 use rustc_hash::{FxHashMap, FxHashSet};
 
-use super::bvh::{Hint, PatchIndex, closest_on_triangle, dist2, unit_normal, within, within_d2};
+use super::bvh::{
+    Hint, PatchIndex, closest_on_segment, closest_on_triangle, dist2, unit_normal, within,
+    within_d2,
+};
 use super::features::{Features, key};
 use super::grid::Grid;
 use super::guard::InputSamples;
@@ -37,6 +40,8 @@ use crate::mesh::surface::SurfaceMesh;
 
 type P3 = [f64; 3];
 
+mod folds;
+pub use folds::{FOLD_ANGLE, min_fold};
 mod necks;
 mod sweep;
 
@@ -617,15 +622,22 @@ impl<'a> Remesher<'a> {
     /// The move of point `v` to `x` (and its target size to `size`, if given) with everything
     /// [`Self::apply_move`] needs, if every check passes; reads the surface only.
     fn check_move(&self, v: u32, x: P3, size: Option<f64>) -> Option<Move> {
+        let floor = if self.repairing {
+            0.0
+        } else {
+            self.worst_angle(&self.vt[v as usize])
+                .min(self.target_angle)
+        };
+        self.check_move_above(v, x, size, floor)
+    }
+
+    /// [`Self::check_move`] with the smallest triangle angle the fan may have after the move
+    /// given (`floor`, degrees).
+    fn check_move_above(&self, v: u32, x: P3, size: Option<f64>, floor: f64) -> Option<Move> {
         if self.is_fixed(v) || x == self.pts[v as usize] {
             return None;
         }
         let fan = &self.vt[v as usize];
-        let floor = if self.repairing {
-            0.0
-        } else {
-            self.worst_angle(fan).min(self.target_angle)
-        };
         let old_normals: Vec<P3> = fan.iter().map(|&t| unit_normal(&self.corners(t))).collect();
         let new: Vec<([u32; 3], [P3; 3])> = fan
             .iter()
@@ -1185,6 +1197,40 @@ impl<'a> Remesher<'a> {
             .collect();
         e.sort_by(|x, y| y.0.total_cmp(&x.0));
         e.iter().any(|&(_, a, b)| self.split(a, b))
+    }
+
+    /// Bring the surface to an input point `p` that triangle `t` is the nearest to but too far
+    /// from: split the edge of `t` nearest to `p` and move the new point onto `p` (a point of
+    /// the input, so the move costs no distance that way) or, if the checks refuse that, as far
+    /// towards it as they allow.
+    pub fn refine_toward(&mut self, t: u32, p: P3) -> bool {
+        if !self.alive[t as usize] {
+            return false;
+        }
+        let tri = self.tris[t as usize];
+        let mut e: Vec<(f64, u32, u32)> = (0..3)
+            .map(|k| {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                let (pa, pb) = (self.pts[a as usize], self.pts[b as usize]);
+                (dist2(p, closest_on_segment(p, pa, pb)), a, b)
+            })
+            .collect();
+        e.sort_by(|x, y| x.0.total_cmp(&y.0));
+        for &(_, a, b) in &e {
+            let mi = self.pts.len() as u32;
+            if self.split(a, b) {
+                // All the way if the checks allow, else as far as they do.
+                let q = self.pts[mi as usize];
+                for f in [1.0, 0.75, 0.5, 0.25] {
+                    let x = [0, 1, 2].map(|k| q[k] + f * (p[k] - q[k]));
+                    if self.try_move(mi, x) {
+                        break;
+                    }
+                }
+                return true;
+            }
+        }
+        false
     }
 
     /// Number of triangles in the surface.

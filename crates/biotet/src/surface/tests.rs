@@ -258,3 +258,40 @@ fn the_final_measure_lists_what_lies_beyond_the_tolerance() {
         assert!(out.triangles[f.triangle as usize].contains(&40), "{f:?}");
     }
 }
+
+/// A flat tetrahedron's triangles have usable angles (20°–70°) but fold onto each other at its
+/// base edges (6.5° inside): every tet there would be as flat. With no edge kept as a feature,
+/// the stage opens the folds within the tolerance (the apex and base corners move apart).
+#[test]
+fn a_flat_fold_is_opened_within_the_tolerance() {
+    let input = SurfaceMesh {
+        points: vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.25, 0.25, 0.04],
+        ],
+        triangles: vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]],
+        sides: vec![[1, 0]; 4],
+    };
+    let d = 0.05;
+    let opts = SurfaceOptions {
+        tolerance: d,
+        feature_angle_deg: 0.0,
+        ..Default::default()
+    };
+    let (out, report) = improve(&input, &opts).expect("improves");
+    assert!(report.hausdorff_in_to_out <= d && report.hausdorff_out_to_in <= d);
+    assert!(brute_one_sided(&out, &input, 4) <= d);
+    assert!(brute_one_sided(&input, &out, 4) <= d);
+    let (f_in, f_out) = (remesh::min_fold(&input), remesh::min_fold(&out));
+    assert!(f_in < 7.0, "{f_in}");
+    assert!(
+        f_out >= remesh::FOLD_ANGLE,
+        "smallest fold {f_in} → {f_out}"
+    );
+    assert_eq!((report.min_fold_in, report.min_fold_out), (f_in, f_out));
+    assert!(report.n_fold_moves > 0);
+    let mut check = out.clone();
+    validate_surface(&mut check, &ValidateOptions::default()).expect("valid output");
+}
