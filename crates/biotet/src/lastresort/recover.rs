@@ -1309,13 +1309,20 @@ impl View<'_> {
                     max_nodes: self.opts.search.max_nodes.min(FIRST_TRY_NODES),
                     ..self.opts.search
                 };
-                match w.searcher.fill(&cav.coords, faces, inner, &o) {
-                    Ok(f) => first = Some(f),
-                    Err(e) => *nodes += nodes_of(&e),
-                }
+                first = Some(w.searcher.fill(&cav.coords, faces, inner, &o));
             }
             let result = match first {
-                Some(f) => Ok(f),
+                Some(Ok(f)) => Ok(f),
+                // No fill, and no apex refused for quality alone: the configured search would
+                // take the same candidates everywhere (a twisted cube's inside, four times a
+                // triangle on the unit cube), so it is not run.
+                // (Its budget is no smaller than the first try's.)
+                Some(Err(e @ SearchError::NoFill { .. })) if !w.searcher.cut_by_quality() => Err(e),
+                Some(Err(e)) => {
+                    *nodes += nodes_of(&e);
+                    w.searcher
+                        .fill(&cav.coords, faces, inner, &self.opts.search)
+                }
                 None => w
                     .searcher
                     .fill(&cav.coords, faces, inner, &self.opts.search),

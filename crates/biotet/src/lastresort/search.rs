@@ -268,6 +268,9 @@ pub struct Searcher {
     /// no cap.
     cap: Option<f64>,
     improve: Option<u64>,
+    /// Whether this search left out an apex in front of its face for ηe alone (see
+    /// [`Searcher::cut_by_quality`]).
+    eta_cut: bool,
     scratch: Vec<[u32; 3]>,
     edges: Vec<(u32, u32)>,
     /// Local point ids sorted by coordinates (the duplicate check).
@@ -470,6 +473,7 @@ impl Searcher {
             4.0 * s * s
         });
         self.improve = opts.improve;
+        self.eta_cut = false;
         self.budget = opts.max_nodes;
         self.nodes = 0;
         self.have_best = false;
@@ -911,11 +915,15 @@ impl Searcher {
             let vol = volume(&corners);
             // q³ ≤ 0 is at most ηe³ when ηe > 0: `above_eta` would refuse it.
             if self.eta > 0.0 && vol <= 0.0 {
+                self.note_eta_cut(f as u32, p);
                 continue;
             }
             let q = q_cubed(vol, &corners);
-            if (self.eta > 0.0 && !self.above_eta(q, &corners))
-                || q <= self.bound
+            if self.eta > 0.0 && !self.above_eta(q, &corners) {
+                self.note_eta_cut(f as u32, p);
+                continue;
+            }
+            if q <= self.bound
                 || self.floor.is_some_and(|f| !dihedrals_above(&corners, f))
                 || self.cap.is_some_and(|c| max_dihedral_chord2(&corners) >= c)
             {
@@ -948,6 +956,22 @@ impl Searcher {
         face.c1 = self.cands.len() as u32;
         face.live = face.c1 - face.c0;
         face.valid = 0;
+    }
+
+    /// Record an apex refused for ηe alone that a search without ηe could take (in front of
+    /// face `f`, exact; the other tests are not checked, so the record may be needless).
+    fn note_eta_cut(&mut self, f: u32, p: u32) {
+        if !self.eta_cut && self.side(f, p) == Sign::Positive {
+            self.eta_cut = true;
+        }
+    }
+
+    /// Whether the last search refused an apex for its [`SearchOptions::min_quality`] alone
+    /// (conservatively). When it did not and found no fill (within its budget), a search with
+    /// the same options but a lower `min_quality` (and no smaller budget) has the same
+    /// candidates at every node, so it finds no fill either.
+    pub(crate) fn cut_by_quality(&self) -> bool {
+        self.eta_cut
     }
 
     /// Is the tet's q strictly above ηe? Decided on q³ unless the two are too close to call,
