@@ -416,6 +416,26 @@ fn recover_checked(
     Ok(report)
 }
 
+/// A cell as [`Recovery::no_fill`] keys it, in mesh point numbers (`points`: the cavity's):
+/// its isolated points sorted, a separator, then its faces rotated to their smallest corner
+/// (orientation kept), sorted. The same cell from any cavity has the same key.
+fn cell_key(points: &[u32], faces: &[[u32; 3]], inner: &[u32]) -> Vec<u32> {
+    let mut key: Vec<u32> = inner.iter().map(|&x| points[x as usize]).collect();
+    key.sort_unstable();
+    key.push(u32::MAX);
+    let mut rot: Vec<[u32; 3]> = faces
+        .iter()
+        .map(|f| {
+            let g = f.map(|x| points[x as usize]);
+            let k = (0..3).min_by_key(|&k| g[k]).unwrap_or(0);
+            [g[k], g[(k + 1) % 3], g[(k + 2) % 3]]
+        })
+        .collect();
+    rot.sort_unstable();
+    key.extend(rot.iter().flatten());
+    key
+}
+
 /// Mesh point numbers by exact coordinates (the first of equal points).
 fn point_index(points: &[P3]) -> FxHashMap<[u64; 3], u32> {
     let mut at: FxHashMap<[u64; 3], u32> = FxHashMap::default();
@@ -638,6 +658,9 @@ struct Recovery<'a> {
     tries: FxHashMap<u32, u8>,
     /// The Steiner fallback carves wider cavities (after a round without progress).
     wide: bool,
+    /// Cells proven to have no fill of their own points (see [`cell_key`]): searched again they
+    /// fail again, so they are not (a twisted cube's inside, in every cavity that holds it).
+    no_fill: FxHashSet<Vec<u32>>,
 }
 
 /// Stamped marks and buffers of the read-only stages (walks, carving, searches): one for the
@@ -667,6 +690,9 @@ struct Work {
     on_face: Vec<bool>,
     inner: Vec<u32>,
     searcher: Searcher,
+    /// Keys of the cells this scratch's calls proved to have no fill, for
+    /// [`Recovery::no_fill`] (merged after each serial call and each batch).
+    proven: Vec<Vec<u32>>,
     cells: Cells,
 }
 
@@ -747,6 +773,8 @@ struct View<'r> {
     surf_list: &'r [u32],
     opts: &'r RecoverOptions,
     face_tri: &'r FaceIndex,
+    /// [`Recovery::no_fill`] as it was when the view was taken.
+    no_fill: &'r FxHashSet<Vec<u32>>,
 }
 
 /// A fill of a triangle's crossed tets found on a batch's view, applied later if nothing it
@@ -1302,30 +1330,43 @@ impl View<'_> {
             );
             // A first, cheaper try among better tets only (ηe raised): fewer candidates, and
             // fewer slivers for the sliver removal that follows; the configured search if not.
-            let mut first = None;
-            if self.opts.first_quality > self.opts.search.min_quality {
-                let o = SearchOptions {
-                    min_quality: self.opts.first_quality,
-                    max_nodes: self.opts.search.max_nodes.min(FIRST_TRY_NODES),
-                    ..self.opts.search
-                };
-                first = Some(w.searcher.fill(&cav.coords, faces, inner, &o));
-            }
-            let result = match first {
-                Some(Ok(f)) => Ok(f),
-                // No fill, and no apex refused for quality alone: the configured search would
-                // take the same candidates everywhere (a twisted cube's inside, four times a
-                // triangle on the unit cube), so it is not run.
-                // (Its budget is no smaller than the first try's.)
-                Some(Err(e @ SearchError::NoFill { .. })) if !w.searcher.cut_by_quality() => Err(e),
-                Some(Err(e)) => {
-                    *nodes += nodes_of(&e);
-                    w.searcher
-                        .fill(&cav.coords, faces, inner, &self.opts.search)
+            let key = cell_key(&cav.points, faces, inner);
+            let result = if self.no_fill.contains(&key) {
+                Err(SearchError::NoFill { nodes_visited: 0 })
+            } else {
+                let mut first = None;
+                if self.opts.first_quality > self.opts.search.min_quality {
+                    let o = SearchOptions {
+                        min_quality: self.opts.first_quality,
+                        max_nodes: self.opts.search.max_nodes.min(FIRST_TRY_NODES),
+                        ..self.opts.search
+                    };
+                    first = Some(w.searcher.fill(&cav.coords, faces, inner, &o));
                 }
-                None => w
-                    .searcher
-                    .fill(&cav.coords, faces, inner, &self.opts.search),
+                let result = match first {
+                    Some(Ok(f)) => Ok(f),
+                    // No fill, and no apex refused for quality alone: the configured search
+                    // would take the same candidates everywhere (a twisted cube's inside, four
+                    // times a triangle on the unit cube), so it is not run. (Its budget is no
+                    // smaller than the first try's.)
+                    Some(Err(e @ SearchError::NoFill { .. })) if !w.searcher.cut_by_quality() => {
+                        Err(e)
+                    }
+                    Some(Err(e)) => {
+                        *nodes += nodes_of(&e);
+                        w.searcher
+                            .fill(&cav.coords, faces, inner, &self.opts.search)
+                    }
+                    None => w
+                        .searcher
+                        .fill(&cav.coords, faces, inner, &self.opts.search),
+                };
+                // A complete search's proof holds for this cell in any later cavity (the
+                // options that bound the fills do not change; widening only adds nodes).
+                if matches!(result, Err(SearchError::NoFill { .. })) {
+                    w.proven.push(key);
+                }
+                result
             };
             match result {
                 Ok(f) => {
@@ -1499,6 +1540,7 @@ impl<'a> Recovery<'a> {
             steiner_points: 0,
             tries: FxHashMap::default(),
             wide: false,
+            no_fill: FxHashSet::default(),
         };
         r.index();
         r
@@ -1541,6 +1583,7 @@ impl<'a> Recovery<'a> {
             surf_list: &self.surf_list,
             opts: &self.opts,
             face_tri: &self.face_tri,
+            no_fill: &self.no_fill,
         }
     }
 
@@ -1550,6 +1593,7 @@ impl<'a> Recovery<'a> {
         // Marks for every tet slot the mesh can hold before it grows again.
         w.fit(self.mesh.tets.capacity(), self.mesh.points.len());
         let r = f(self.view(), &mut w);
+        self.no_fill.extend(w.proven.drain(..));
         self.work = w;
         r
     }
@@ -1703,6 +1747,12 @@ impl<'a> Recovery<'a> {
                     view.try_crossed(&mut w, v)
                 })
                 .collect();
+            // Every call of the batch read the memo as it was before it: the union is the same
+            // for any thread count.
+            for w in &mut pool {
+                let w = w.get_mut().unwrap_or_else(|e| e.into_inner());
+                self.no_fill.extend(w.proven.drain(..));
+            }
             if let Some(w) = pool.pop() {
                 self.work = w.into_inner().unwrap_or_else(|e| e.into_inner());
             }
