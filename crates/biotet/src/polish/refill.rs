@@ -11,7 +11,7 @@ use rustc_hash::FxHashSet;
 use crate::lastresort::{SearchOptions, Searcher};
 
 use super::work::{P3, Work};
-use crate::geom::vec3::volume6;
+use crate::geom::vec3::{cross, dot, norm, sub, volume6};
 use crate::quality::tet::min_dihedral_chord2;
 
 /// Search budget of one refill.
@@ -101,6 +101,31 @@ pub(super) fn every_face_has_candidate(
 ) -> bool {
     let lim = chord_of(floor);
     shell.iter().all(|f| has_candidate(pts, f, cands, lim))
+}
+
+/// How many shell faces have every tet with its fourth corner in the hull of `verts` below
+/// `deg` degrees. A tet on face f whose apex is at height H over f's plane has a dihedral angle
+/// at an edge of f of at most atan(H / r), r the inradius of f: the apex's projection is at
+/// least r from one of f's edge lines on f's side (the edges' signed distances weighted by their
+/// lengths sum to twice f's area). With the fill's points in the hull, H is at most the largest
+/// height of `verts`. Floating point with a margin of 1e-6 relative, far above its rounding, so
+/// a face counted has its tets below `deg` as the angles are measured.
+pub(super) fn faces_flat_in_hull(pts: &[P3], shell: &[[u32; 3]], verts: &[u32], deg: f64) -> usize {
+    let t = deg.to_radians().tan() * (1.0 - 1e-6);
+    shell
+        .iter()
+        .filter(|f| {
+            let q = f.map(|v| pts[v as usize]);
+            let n = cross(sub(q[1], q[0]), sub(q[2], q[0]));
+            let per: f64 = (0..3).map(|k| norm(sub(q[(k + 1) % 3], q[k]))).sum();
+            // H·|n| for the highest point, |n| twice the area and r = |n| / per.
+            let h = verts
+                .iter()
+                .map(|&v| dot(n, sub(pts[v as usize], q[0])).abs())
+                .fold(0.0, f64::max);
+            h * per < t * dot(n, n)
+        })
+        .count()
 }
 
 /// How many shell faces have no point making a tet with them above `floor` degrees: every fill
