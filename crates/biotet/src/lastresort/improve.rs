@@ -240,6 +240,9 @@ struct Work<'a> {
     free: Vec<u32>,
     /// Per tet: its local moves were tried and failed (it waits for its larger cavities).
     local_tried: Vec<bool>,
+    /// Rings around an edge (their tets' corners, sorted) whose search proved that no fill
+    /// exists: each tet around the edge would search the same ring again.
+    ring_no_fill: FxHashSet<Vec<[u32; 4]>>,
     opts: ImproveOptions,
     report: ImproveReport,
     /// Per search: milliseconds and nodes (for the medians; a byte count per search matters on
@@ -650,6 +653,14 @@ impl<'a> Work<'a> {
         }
     }
 
+    /// A ring's content: its tets' corners, sorted (points never move here, so equal keys
+    /// are equal cavities, and an exhausted search of one is exhausted for the other).
+    fn ring_key(&self, ring: &[u32]) -> Vec<[u32; 4]> {
+        let mut key: Vec<[u32; 4]> = ring.iter().map(|&t| self.tets[t as usize]).collect();
+        key.sort_unstable();
+        key
+    }
+
     /// Whether the input forces `tet` to be poor (see [`ImproveOptions::forced_deg`]).
     fn is_forced(&mut self, tet: u32) -> bool {
         match self.forced[tet as usize] {
@@ -776,13 +787,21 @@ fn step(w: &mut Work, tet: u32, scratch: &mut Vec<u32>) -> Step {
             }
         }
         let tv = w.tets[tet as usize];
+        // A ring known to have no fill is not searched again, but still claimed: the batches,
+        // and so the result, stay as they were.
+        let mut known = Vec::new();
         for e in crate::mesh::tet::TET_EDGES {
             if let Some(ring) = w.ring(tet, tv[e[0]], tv[e[1]], label) {
-                tries.push((Kind::Ring, ring));
+                if w.ring_no_fill.contains(&w.ring_key(&ring)) {
+                    known.extend_from_slice(&ring);
+                } else {
+                    tries.push((Kind::Ring, ring));
+                }
             }
         }
-        if !tries.is_empty() {
+        if !tries.is_empty() || !known.is_empty() {
             let mut all: Vec<u32> = tries.iter().flat_map(|(_, t)| t.iter().copied()).collect();
+            all.extend_from_slice(&known);
             all.sort_unstable();
             all.dedup();
             if w.claimed(&all) {
@@ -924,6 +943,12 @@ fn run_batch(w: &mut Work, batch: &mut Vec<Task>) {
                 Kind::Star => |r| &mut r.star_cavities,
                 Kind::Grown => |r| &mut r.grown_cavities,
             };
+            if t.kind == Kind::Ring
+                && matches!(&out.result, Err(e) if !matches!(e, SearchError::Budget { .. }))
+            {
+                let key = w.ring_key(&t.cav.tets);
+                w.ring_no_fill.insert(key);
+            }
             if w.record(out, plan, counts) {
                 if let Ok(fill) = &out.result {
                     w.replace(&t.cav, &fill.tets);
@@ -1005,6 +1030,7 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
         star_stamp: 0,
         free: Vec::new(),
         local_tried: Vec::new(),
+        ring_no_fill: FxHashSet::default(),
         opts: *opts,
         report: ImproveReport {
             metric: Some(opts.metric),
