@@ -303,23 +303,32 @@ impl Work {
         // insertion kept.
         let large = tets.len() > 5;
         let (cav, on_shell) = self.cavity_of_shell_points(tets)?;
-        let old = judge(self, &cav.tets, thr, by);
         // Shell faces on which every fill has a tet below the threshold, wherever the point
-        // goes: more of them than the cavity's tets below it now rule out the cone, a quarter
-        // as many more (or a large cavity) the lower floor's search, and one below half of it
-        // a rescue. On a thin box whose faces are gridded much coarser than its thickness,
-        // about a third of the insertions end here without placing a point.
+        // goes: more of them than the cavity's tets below it now rule out the cone; a quarter
+        // as many more (or a large cavity) the lower floor's search; one below half the
+        // threshold a rescue. On a thin box whose faces are gridded much coarser than its
+        // thickness, a third of the insertions end here without placing a point. The cavity is
+        // judged here only when such a face exists (judging costs more than the count).
+        let mut judged = None;
         if self.rescue == Rescue::Off {
             let verts: Vec<u32> = on_shell.iter().copied().collect();
             let doomed = faces_flat_in_hull(&self.pts, &cav.shell, &verts, thr);
-            if doomed > old.2
-                && (large || doomed.div_ceil(4) > old.2)
-                && faces_flat_in_hull(&self.pts, &cav.shell, &verts, 0.5 * thr) > 0
-            {
-                return None;
+            if doomed > 0 {
+                let old = judge(self, &cav.tets, thr, by);
+                if doomed > old.2
+                    && (large || doomed.div_ceil(4) > old.2)
+                    && faces_flat_in_hull(&self.pts, &cav.shell, &verts, 0.5 * thr) > 0
+                {
+                    return None;
+                }
+                judged = Some(old);
             }
         }
         let (x, cone_ok) = self.best_point(t, &cav.tets, &cav.shell, thr)?;
+        let old = match judged {
+            Some(old) => old,
+            None => judge(self, &cav.tets, thr, by),
+        };
         // In the last pass, a flat tet (under a thousandth of the threshold: gmsh's t13 kept two
         // at 3e-15°, a solver's stiffness matrix then singular to round-off) is traded for any
         // fill whose every tet is above a hundredth of it, however many are then below it.

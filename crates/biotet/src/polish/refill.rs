@@ -118,12 +118,12 @@ pub(super) fn faces_flat_in_hull(pts: &[P3], shell: &[[u32; 3]], verts: &[u32], 
             let q = f.map(|v| pts[v as usize]);
             let n = cross(sub(q[1], q[0]), sub(q[2], q[0]));
             let per: f64 = (0..3).map(|k| norm(sub(q[(k + 1) % 3], q[k]))).sum();
-            // H·|n| for the highest point, |n| twice the area and r = |n| / per.
-            let h = verts
+            // Each point's H·|n| against the bound (|n| twice the area, r = |n| / per); the first
+            // point above it ends the face's scan, so a cavity that is not flat costs little.
+            let lim = t * dot(n, n);
+            verts
                 .iter()
-                .map(|&v| dot(n, sub(pts[v as usize], q[0])).abs())
-                .fold(0.0, f64::max);
-            h * per < t * dot(n, n)
+                .all(|&v| dot(n, sub(pts[v as usize], q[0])).abs() * per < lim)
         })
         .count()
 }
