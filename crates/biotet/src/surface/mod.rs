@@ -36,6 +36,7 @@ use crate::geom::vec3::volume6;
 use crate::mesh::surface::SurfaceMesh;
 use crate::mesh::validate::{self, ValidateOptions, validate_surface};
 use bvh::PatchIndex;
+use rustc_hash::FxHashSet;
 
 /// What [`improve`] does.
 #[derive(Debug, Clone, PartialEq)]
@@ -356,7 +357,7 @@ pub fn improve_with_progress(
     }
     // Folds the triangles' own angles do not see (a thin finger's flat tip) force tets as
     // sharp as they are.
-    let folds_opened = r.open_folds();
+    let mut folds_opened = r.open_folds();
     // Validate and measure; where the dense measure finds the output beyond D or cannot prove
     // it within, split there and project (the repair), validate and measure again, a bounded
     // number of times. (A coarser repair pass before it, splitting wherever a sample was beyond
@@ -365,6 +366,8 @@ pub fn improve_with_progress(
     let seconds_remesh = clock.elapsed().as_secs_f64();
     r.repairing = true;
     let mut repair_rounds = 0;
+    // The input samples found beyond D by the last measure.
+    let mut far_before: FxHashSet<[u64; 3]> = FxHashSet::default();
     let mut seconds_measure = 0.0;
     let (out, oi, io) = loop {
         progress("validating");
@@ -395,7 +398,10 @@ pub fn improve_with_progress(
             break (out, oi, io);
         }
         progress("repair");
-        refine_where_far(&mut r, &oi, &io, |t| ids[t as usize]);
+        refine_where_far(&mut r, &oi, &io, &far_before, |t| ids[t as usize]);
+        far_before = io.far.iter().map(|x| x.point.map(f64::to_bits)).collect();
+        // The splits and projections may fold the surface again.
+        folds_opened += r.open_folds();
         repair_rounds += 1;
     };
     let seconds_repair = clock.elapsed().as_secs_f64() - seconds_remesh - seconds_measure;
@@ -532,23 +538,39 @@ fn both_ways(
 
 /// Split and project where the measure found the output far: the output triangles of far
 /// samples and the output triangles nearest to far input samples (`id` maps a measured
-/// triangle to the remesher's), each once, in order.
+/// triangle to the remesher's), each once, in order; an input sample that was far before this
+/// repair too (`again`) gets a point moved onto it instead.
 fn refine_where_far(
     r: &mut remesh::Remesher,
     oi: &hausdorff::Sided,
     io: &hausdorff::Sided,
+    again: &FxHashSet<[u64; 3]>,
     id: impl Fn(u32) -> u32,
 ) {
-    let mut targets: Vec<u32> = oi.far.iter().map(|x| id(x.triangle)).collect();
+    let mut targets: Vec<u32> = oi
+        .far
+        .iter()
+        .map(|x| id(x.triangle))
+        .chain(
+            io.far
+                .iter()
+                .filter(|x| !again.contains(&x.point.map(f64::to_bits)))
+                .map(|x| id(x.nearest)),
+        )
+        .collect();
     targets.sort_unstable();
     targets.dedup();
     for t in targets {
         r.refine_triangle(t);
     }
-    // An input point too far from the output: a point of the output goes there. (Splitting the
-    // nearest triangle and projecting its midpoint can miss it round after round: at a pinch
-    // of the input the projection lands on the other side of the pinch.)
-    for x in &io.far {
+    // An input sample still too far after a repair: a point of the output goes there. (The
+    // projected midpoint can miss it round after round: at a pinch of the input it lands on the
+    // other side.) Only then, since the moved point may make a poorer triangle than the split.
+    for x in io
+        .far
+        .iter()
+        .filter(|x| again.contains(&x.point.map(f64::to_bits)))
+    {
         r.refine_toward(id(x.nearest), x.point);
     }
 }
