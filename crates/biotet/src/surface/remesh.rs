@@ -1138,13 +1138,7 @@ impl<'a> Remesher<'a> {
                 continue;
             }
             let tri = self.tris[t as usize];
-            let mut e: Vec<(f64, u32, u32)> = (0..3)
-                .map(|k| {
-                    let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                    (self.len(a, b), a, b)
-                })
-                .collect();
-            e.sort_by(|x, y| x.0.total_cmp(&y.0));
+            let e = self.edges_by(t, |a, b| self.len(a, b));
             let mut ok = false;
             for &(_, a, b) in e.iter().rev() {
                 if self.flip(a, b) {
@@ -1188,15 +1182,23 @@ impl<'a> Remesher<'a> {
         if !self.alive[t as usize] {
             return false;
         }
+        // Longest first; equal lengths in the triangle's order.
+        let mut e = self.edges_by(t, |a, b| self.len(a, b));
+        e.sort_by(|x, y| y.0.total_cmp(&x.0));
+        e.iter().any(|&(_, a, b)| self.split(a, b))
+    }
+
+    /// The edges `(key, a, b)` of triangle `t`, by increasing `key(a, b)`.
+    fn edges_by(&self, t: u32, key: impl Fn(u32, u32) -> f64) -> Vec<(f64, u32, u32)> {
         let tri = self.tris[t as usize];
         let mut e: Vec<(f64, u32, u32)> = (0..3)
             .map(|k| {
                 let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                (self.len(a, b), a, b)
+                (key(a, b), a, b)
             })
             .collect();
-        e.sort_by(|x, y| y.0.total_cmp(&x.0));
-        e.iter().any(|&(_, a, b)| self.split(a, b))
+        e.sort_by(|x, y| x.0.total_cmp(&y.0));
+        e
     }
 
     /// Bring the surface to an input point `p` that triangle `t` is the nearest to but too far
@@ -1207,15 +1209,12 @@ impl<'a> Remesher<'a> {
         if !self.alive[t as usize] {
             return false;
         }
-        let tri = self.tris[t as usize];
-        let mut e: Vec<(f64, u32, u32)> = (0..3)
-            .map(|k| {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                let (pa, pb) = (self.pts[a as usize], self.pts[b as usize]);
-                (dist2(p, closest_on_segment(p, pa, pb)), a, b)
-            })
-            .collect();
-        e.sort_by(|x, y| x.0.total_cmp(&y.0));
+        let e = self.edges_by(t, |a, b| {
+            dist2(
+                p,
+                closest_on_segment(p, self.pts[a as usize], self.pts[b as usize]),
+            )
+        });
         for &(_, a, b) in &e {
             let mi = self.pts.len() as u32;
             if self.split(a, b) {
