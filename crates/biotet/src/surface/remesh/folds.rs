@@ -135,24 +135,15 @@ impl Remesher<'_> {
     /// the final measure then found 0.266 between their samples).
     fn fan_near_input(&self, v: u32, x: P3) -> bool {
         let h = self.tol / 4.0;
-        let t2 = self.tol * self.tol;
+        let mut hint = Hint::default();
         self.vt[v as usize].iter().all(|&t| {
-            let Some(bvh) = self.input.get(self.sides[t as usize]) else {
-                return false;
-            };
             let c = self.tris[t as usize].map(|u| if u == v { x } else { self.pts[u as usize] });
             let longest = (0..3)
                 .map(|k| norm(sub(c[(k + 1) % 3], c[k])))
                 .fold(0.0, f64::max);
-            let n = ((longest / h).ceil() as usize).clamp(1, 64);
-            let mut hint = Hint::default();
-            (0..=n).all(|i| {
-                (0..=n - i).all(|j| {
-                    let w = [i, j, n - i - j].map(|k| k as f64 / n as f64);
-                    let p = [0, 1, 2].map(|a| w[0] * c[0][a] + w[1] * c[1][a] + w[2] * c[2][a]);
-                    bvh.any_within_hinted(p, t2, &mut hint)
-                })
-            })
+            let n = ((longest / h).ceil() as usize).clamp(1, 64) as u8;
+            self.near_input(&c, self.sides[t as usize], n, None, &mut hint)
+                .is_some()
         })
     }
 
