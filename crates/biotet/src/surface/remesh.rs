@@ -40,6 +40,7 @@ use crate::mesh::surface::SurfaceMesh;
 
 type P3 = [f64; 3];
 
+mod batch;
 mod folds;
 pub use folds::{FOLD_ANGLE, min_fold};
 mod necks;
@@ -88,6 +89,34 @@ struct Move {
     size: Option<f64>,
     devs: Vec<(f64, u8)>,
     plan: Vec<(u32, u32, f64)>,
+}
+
+/// A checked edge collapse ([`Remesher::check_collapse`]): `a` goes, `b` stays (at `x`); the
+/// two triangles at the edge die, the others around `a` (and `b`, if it moves) take the new
+/// corners in `kept`, with their distance bounds and the input samples' new covers.
+struct Collapse {
+    b: u32,
+    x: P3,
+    size: Option<f64>,
+    dead: [u32; 2],
+    kept: Vec<(u32, [u32; 3])>,
+    devs: Vec<(f64, u8)>,
+    plan: Vec<(u32, u32, f64)>,
+}
+
+/// A checked edge flip ([`Remesher::check_flip`]).
+enum Flip {
+    /// Not an edge with two triangles that may flip, or a check refused it.
+    Refused,
+    /// The flip raises no angle: remembered at triangle `t`, edge `k` (`Remesher::no_flip`).
+    NoGain(u32, usize),
+    /// Triangles `t[k]` become `tris[k]`, with their bounds and the samples' new covers.
+    Do {
+        t: [u32; 2],
+        tris: [[u32; 3]; 2],
+        devs: Vec<(f64, u8)>,
+        plan: Vec<(u32, u32, f64)>,
+    },
 }
 
 /// Counts of applied operations.
@@ -771,25 +800,34 @@ impl<'a> Remesher<'a> {
 
     /// [`Self::collapse`] (`b` stays) or [`Self::collapse_mid`] (`b` moves to the middle).
     fn collapse_to(&mut self, a: u32, b: u32, middle: bool, factor: f64) -> bool {
-        if self.is_fixed(a) || (middle && self.is_fixed(b)) || self.feature.contains(&key(a, b)) {
-            return false;
+        match self.check_collapse(a, b, middle, factor) {
+            Some(c) => {
+                self.apply_collapse(c);
+                true
+            }
+            None => false,
         }
-        let Some((t1, t2, c, d)) = self.edge_pair(a, b) else {
-            return false;
-        };
+    }
+
+    /// [`Self::collapse_to`]'s collapse, if every check passes; reads the surface only.
+    fn check_collapse(&self, a: u32, b: u32, middle: bool, factor: f64) -> Option<Collapse> {
+        if self.is_fixed(a) || (middle && self.is_fixed(b)) || self.feature.contains(&key(a, b)) {
+            return None;
+        }
+        let (t1, t2, c, d) = self.edge_pair(a, b)?;
         if c == d {
-            return false;
+            return None;
         }
         // Link condition: the common neighbours of a and b are c and d alone.
         let na = self.neighbours(a);
         let nb = self.neighbours(b);
         let common = na.iter().filter(|x| nb.binary_search(x).is_ok()).count();
         if common != 2 {
-            return false;
+            return None;
         }
         let (da, db) = (self.vt[a as usize].len(), self.vt[b as usize].len());
         if da + db < 7 || self.vt[c as usize].len() < 4 || self.vt[d as usize].len() < 4 {
-            return false;
+            return None;
         }
         let (pa, pb) = (self.pts[a as usize], self.pts[b as usize]);
         let (x, h) = if middle {
@@ -803,11 +841,9 @@ impl<'a> Remesher<'a> {
             };
             let (oa, ob) = (others(&na), others(&nb));
             if oa.iter().any(|&u| ob.iter().any(|&w| self.has_edge(u, w))) {
-                return false;
+                return None;
             }
-            let Some((x, h)) = self.project(b, scale(add(pa, pb), 0.5)) else {
-                return false;
-            };
+            let (x, h) = self.project(b, scale(add(pa, pb), 0.5))?;
             (x, Some(h))
         } else {
             (pb, None)
@@ -818,7 +854,7 @@ impl<'a> Remesher<'a> {
             let m = factor * self.target(b, u);
             u != a && u != b && dist2(self.pts[u as usize], x) > m * m
         }) {
-            return false;
+            return None;
         }
         let mut fan: Vec<u32> = self.vt[a as usize].clone();
         if middle {
@@ -847,11 +883,9 @@ impl<'a> Remesher<'a> {
             })
             .collect();
         if !self.shape_ok(&new, &old_normals, floor) {
-            return false;
+            return None;
         }
-        let Some(devs) = self.new_near_input(&new, &kept, None) else {
-            return false;
-        };
+        let devs = self.new_near_input(&new, &kept, None)?;
         // The removed points lay on (or near) the input: the new fan must pass near them.
         let t2r = self.tol * self.tol;
         let removed: &[P3] = if middle { &[pa, pb] } else { &[pa] };
@@ -859,39 +893,69 @@ impl<'a> Remesher<'a> {
             .iter()
             .any(|&p| !new.iter().any(|(_, c)| within(p, c, self.tol, t2r)))
         {
-            return false;
+            return None;
         }
-        let Some(plan) = self.recover_samples(&fan, &new, &kept, 0.0) else {
-            return false;
-        };
+        let plan = self.recover_samples(&fan, &new, &kept, 0.0)?;
         if self.crosses(&new, &fan) {
-            return false;
+            return None;
         }
-        self.kill(t1);
-        self.kill(t2);
+        Some(Collapse {
+            b,
+            x,
+            size: h,
+            dead: [t1, t2],
+            kept: kept
+                .iter()
+                .zip(&new)
+                .map(|(&t, &(tri, _))| (t, tri))
+                .collect(),
+            devs,
+            plan,
+        })
+    }
+
+    /// Apply a collapse [`Self::check_collapse`] made on the surface as it stands.
+    fn apply_collapse(&mut self, c: Collapse) {
+        let Collapse {
+            b,
+            x,
+            size,
+            dead,
+            kept,
+            devs,
+            plan,
+        } = c;
+        for t in dead {
+            self.kill(t);
+        }
         self.pts[b as usize] = x;
-        if let Some(h) = h {
+        if let Some(h) = size {
             self.size[b as usize] = self.size[b as usize].min(h);
         }
-        for (&t, (tri, _)) in kept.iter().zip(&new) {
-            self.replace(t, *tri);
+        for &(t, tri) in &kept {
+            self.replace(t, tri);
         }
         self.apply_covers(&plan);
-        for (&t, d) in kept.iter().zip(devs) {
+        for (&(t, _), d) in kept.iter().zip(devs) {
             self.dev[t as usize] = d;
         }
         self.counts.collapses += 1;
-        true
     }
 
     /// Flip edge `ab` to `cd` if that raises the smaller of the two triangles' smallest angles
     /// and every check passes.
     pub fn flip(&mut self, a: u32, b: u32) -> bool {
+        let f = self.check_flip(a, b);
+        self.apply_flip(f)
+    }
+
+    /// [`Self::flip`]'s flip, checked; reads the surface only.
+    fn check_flip(&self, a: u32, b: u32) -> Flip {
         if self.feature.contains(&key(a, b)) {
-            return false;
+            return Flip::Refused;
         }
         let Some((t1, t2, c, d)) = self.edge_pair(a, b) else {
-            return false;
+            return Flip::Refused;
         };
         if c == d
             || self.sides[t1 as usize] != self.sides[t2 as usize]
@@ -899,7 +963,7 @@ impl<'a> Remesher<'a> {
             || self.vt[b as usize].len() < 4
             || self.has_edge(c, d)
         {
-            return false;
+            return Flip::Refused;
         }
         let k1 = self.tris[t1 as usize]
             .iter()
@@ -907,7 +971,7 @@ impl<'a> Remesher<'a> {
             .unwrap_or(0);
         if self.no_flip[t1 as usize][k1] > self.changed[t1 as usize].max(self.changed[t2 as usize])
         {
-            return false;
+            return Flip::Refused;
         }
         let p = |v: u32| self.pts[v as usize];
         let new = [
@@ -918,40 +982,63 @@ impl<'a> Remesher<'a> {
         let old_min = min_angle_deg(&old[0]).min(min_angle_deg(&old[1]));
         let new_min = min_angle_deg(&new[0].1).min(min_angle_deg(&new[1].1));
         if new_min <= old_min + 1e-9 {
-            self.clock += 1;
-            self.no_flip[t1 as usize][k1] = self.clock;
-            return false;
+            return Flip::NoGain(t1, k1);
         }
         let n_old = {
             let s = add(unit_normal(&old[0]), unit_normal(&old[1]));
             let l = norm(s);
             if l == 0.0 {
-                return false;
+                return Flip::Refused;
             }
             scale(s, 1.0 / l)
         };
         if !self.shape_ok(&new, &[n_old, n_old], 0.0) {
-            return false;
+            return Flip::Refused;
         }
         if dot(unit_normal(&new[0].1), unit_normal(&new[1].1)) < 0.5 {
-            return false;
+            return Flip::Refused;
         }
         let Some(devs) = self.new_near_input(&new, &[t1, t2], None) else {
-            return false;
+            return Flip::Refused;
         };
         let Some(plan) = self.recover_samples(&[t1, t2], &new, &[t1, t2], 0.0) else {
-            return false;
+            return Flip::Refused;
         };
         if self.crosses(&new, &[t1, t2]) {
-            return false;
+            return Flip::Refused;
         }
-        self.replace(t1, new[0].0);
-        self.replace(t2, new[1].0);
-        self.apply_covers(&plan);
-        self.dev[t1 as usize] = devs[0];
-        self.dev[t2 as usize] = devs[1];
-        self.counts.flips += 1;
-        true
+        Flip::Do {
+            t: [t1, t2],
+            tris: [new[0].0, new[1].0],
+            devs,
+            plan,
+        }
+    }
+
+    /// Apply what [`Self::check_flip`] found on the surface as it stands: whether it flipped.
+    fn apply_flip(&mut self, f: Flip) -> bool {
+        match f {
+            Flip::Refused => false,
+            Flip::NoGain(t, k) => {
+                self.clock += 1;
+                self.no_flip[t as usize][k] = self.clock;
+                false
+            }
+            Flip::Do {
+                t,
+                tris,
+                devs,
+                plan,
+            } => {
+                self.replace(t[0], tris[0]);
+                self.replace(t[1], tris[1]);
+                self.apply_covers(&plan);
+                self.dev[t[0] as usize] = devs[0];
+                self.dev[t[1] as usize] = devs[1];
+                self.counts.flips += 1;
+                true
+            }
+        }
     }
 
     /// Tangential relaxation of `v`: towards the mean of its neighbours within its tangent
@@ -1046,7 +1133,16 @@ impl<'a> Remesher<'a> {
                 }
             }
         }
-        // Collapse short edges, shortest first.
+        self.collapse_short(lo, hi);
+        self.flips();
+        self.relax_all();
+    }
+
+    /// Collapse the edges shorter than `lo` times their target, shortest first, the new edges
+    /// no longer than `hi` times theirs; an edge refused both ways is not tried again while the
+    /// triangles at its ends stay. The checks run in batches ([`batch`]).
+    /// Returns the number of collapses checked again.
+    fn collapse_short(&mut self, lo: f64, hi: f64) -> usize {
         let mut short: Vec<(f64, u32, u32)> = self
             .edges()
             .into_iter()
@@ -1054,25 +1150,39 @@ impl<'a> Remesher<'a> {
             .filter(|e| e.0 < lo)
             .collect();
         short.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
-        for (_, a, b) in short {
-            if self.vt[a as usize].is_empty()
-                || self.vt[b as usize].is_empty()
-                || !self.has_edge(a, b)
-                || self.rel(a, b) >= lo
-            {
-                continue;
-            }
-            let around = self.changed_around(&[a, b]);
-            if self.no_collapse.get(&(a, b)).is_some_and(|&at| at > around) {
-                continue;
-            }
-            if !self.collapse(a, b, hi) && !self.collapse(b, a, hi) {
-                self.clock += 1;
-                self.no_collapse.insert((a, b), self.clock);
-            }
-        }
-        self.flips();
-        self.relax_all();
+        self.in_batches(
+            &short,
+            |r, &(_, a, b)| {
+                // Whether to try reads the triangles at `a` and `b` only: an operation that
+                // changes one of them has `a` or `b` in its box.
+                let skip = r.vt[a as usize].is_empty()
+                    || r.vt[b as usize].is_empty()
+                    || !r.has_edge(a, b)
+                    || r.rel(a, b) >= lo
+                    || r.no_collapse
+                        .get(&(a, b))
+                        .is_some_and(|&at| at > r.changed_around(&[a, b]));
+                if skip {
+                    return (r.points_box(&[a, b]), None);
+                }
+                let c = r
+                    .check_collapse(a, b, false, hi)
+                    .or_else(|| r.check_collapse(b, a, false, hi));
+                (r.fans_box(&[a, b]), Some(c))
+            },
+            |r, &(_, a, b), c| match c {
+                None => false,
+                Some(Some(c)) => {
+                    r.apply_collapse(c);
+                    true
+                }
+                Some(None) => {
+                    r.clock += 1;
+                    r.no_collapse.insert((a, b), r.clock);
+                    false
+                }
+            },
+        )
     }
 
     /// Flip edges until no flip raises an angle (bounded number of sweeps).
@@ -1088,11 +1198,19 @@ impl<'a> Remesher<'a> {
         let mut since = since;
         for _ in 0..3 {
             let (before, start) = (self.counts.flips, self.clock);
-            for (a, b) in self.edges_since(since) {
-                if self.has_edge(a, b) {
-                    self.flip(a, b);
-                }
-            }
+            let edges = self.edges_since(since);
+            self.in_batches(
+                &edges,
+                |r, &(a, b)| {
+                    let read = r.fans_box(&[a, b]);
+                    if r.has_edge(a, b) {
+                        (read, r.check_flip(a, b))
+                    } else {
+                        (read, Flip::Refused)
+                    }
+                },
+                |r, _, f| r.apply_flip(f),
+            );
             if self.counts.flips == before {
                 break;
             }

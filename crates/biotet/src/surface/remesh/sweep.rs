@@ -8,60 +8,19 @@
 //! than the reach of a move (its fan's box, grown by the tolerance the distance checks look
 //! within) in all but rare cases; a move whose reach meets that of a move applied before it in
 //! the step is checked again first. So a sweep gives what checking and applying one point at a
-//! time in this order gives, on any number of threads.
+//! time in this order gives, on any number of threads ([`super::batch`] does the same for an
+//! ordered list of operations).
 
 use rayon::prelude::*;
 
-use super::{Grid, Move, P3, Remesher};
-
-/// Fewer points than this in a step are checked on the calling thread.
-const PARALLEL_STEP: usize = 8;
-
-/// An axis-aligned box.
-type Boxed = (P3, P3);
-
-fn meets(a: &Boxed, b: &Boxed) -> bool {
-    (0..3).all(|k| a.0[k] <= b.1[k] && b.0[k] <= a.1[k])
-}
-
-/// The boxes of the moves applied in a step, in a [`Grid`] by the cells they cover.
-struct Taken {
-    boxes: Vec<Boxed>,
-    grid: Grid,
-    cand: Vec<u32>,
-}
-
-impl Taken {
-    fn new(h: f64) -> Taken {
-        Taken {
-            boxes: Vec::new(),
-            grid: Grid::new(h),
-            cand: Vec::new(),
-        }
-    }
-
-    fn add(&mut self, b: Boxed) {
-        self.grid.insert_box(self.boxes.len() as u32, b.0, b.1);
-        self.boxes.push(b);
-    }
-
-    fn meets(&mut self, b: &Boxed) -> bool {
-        self.grid.query(b.0, b.1, &mut self.cand);
-        self.cand.iter().any(|&i| meets(&self.boxes[i as usize], b))
-    }
-
-    fn clear(&mut self) {
-        self.boxes.clear();
-        self.grid.clear();
-    }
-}
+use super::batch::{Boxed, PARALLEL_STEP, Taken, grow};
+use super::{Move, P3, Remesher};
 
 impl Remesher<'_> {
     /// Relax every point once ([`Self::relax`]), in the order of the module's steps; the number
     /// of moves checked again.
     pub fn relax_all(&mut self) -> usize {
-        // The distance checks look within the working tolerance (a margin for rounding).
-        let reach = self.tol.max(0.0) * (1.0 + 1e-6);
+        let reach = self.reach();
         let cube = 4.0 * self.l + 4.0 * reach;
         let mut taken = Taken::new(cube / 4.0);
         let mut again = 0;
@@ -168,10 +127,6 @@ impl Remesher<'_> {
         }
         (grow((lo, hi), reach), m)
     }
-}
-
-fn grow(b: Boxed, r: f64) -> Boxed {
-    (b.0.map(|x| x - r), b.1.map(|x| x + r))
 }
 
 #[cfg(test)]
