@@ -41,6 +41,7 @@ use crate::mesh::surface::SurfaceMesh;
 type P3 = [f64; 3];
 
 mod batch;
+use batch::Wrote;
 mod folds;
 pub use folds::{FOLD_ANGLE, min_fold};
 mod necks;
@@ -117,6 +118,19 @@ enum Flip {
         devs: Vec<(f64, u8)>,
         plan: Vec<(u32, u32, f64)>,
     },
+}
+
+/// What [`Remesher::check_clean`] found for a triangle.
+struct Clean {
+    /// Flips refused for no gain, to remember ([`Flip::NoGain`]).
+    no_gain: Vec<(u32, usize)>,
+    /// The first flip or collapse that passes.
+    op: Option<CleanOp>,
+}
+
+enum CleanOp {
+    Flip(Flip),
+    Collapse(Collapse),
 }
 
 /// Counts of applied operations.
@@ -1171,15 +1185,15 @@ impl<'a> Remesher<'a> {
                 (r.fans_box(&[a, b]), Some(c))
             },
             |r, &(_, a, b), c| match c {
-                None => false,
+                None => Wrote::Nothing,
                 Some(Some(c)) => {
                     r.apply_collapse(c);
-                    true
+                    Wrote::Read
                 }
                 Some(None) => {
                     r.clock += 1;
                     r.no_collapse.insert((a, b), r.clock);
-                    false
+                    Wrote::Nothing
                 }
             },
         )
@@ -1198,19 +1212,13 @@ impl<'a> Remesher<'a> {
         let mut since = since;
         for _ in 0..3 {
             let (before, start) = (self.counts.flips, self.clock);
-            let edges = self.edges_since(since);
-            self.in_batches(
-                &edges,
-                |r, &(a, b)| {
-                    let read = r.fans_box(&[a, b]);
-                    if r.has_edge(a, b) {
-                        (read, r.check_flip(a, b))
-                    } else {
-                        (read, Flip::Refused)
-                    }
-                },
-                |r, _, f| r.apply_flip(f),
-            );
+            // One at a time: in this order (by point index) neighbouring edges follow each
+            // other, and in batches most flips met an earlier one's box and were checked again.
+            for (a, b) in self.edges_since(since) {
+                if self.has_edge(a, b) {
+                    self.flip(a, b);
+                }
+            }
             if self.counts.flips == before {
                 break;
             }
@@ -1248,50 +1256,106 @@ impl<'a> Remesher<'a> {
             self.failed_middle = self.middle;
             self.failed_at.fill(0);
         }
-        for t in bad {
-            if !self.alive[t as usize] || min_angle_deg(&self.corners(t)) >= self.target_angle {
-                continue;
-            }
-            if self.failed_at[t as usize] > self.changed_around(&self.tris[t as usize]) {
-                continue;
-            }
-            let tri = self.tris[t as usize];
-            let e = self.edges_by(t, |a, b| self.len(a, b));
-            let mut ok = false;
-            for &(_, a, b) in e.iter().rev() {
-                if self.flip(a, b) {
-                    ok = true;
-                    break;
+        self.in_batches(
+            &bad,
+            |r, &t| {
+                let tri = r.tris[t as usize];
+                match r.check_clean(t, hi) {
+                    None => (r.points_box(&tri), None),
+                    Some(c) => (r.fans_box(&tri), Some(c)),
                 }
-            }
-            for &(_, a, b) in &e {
-                if ok {
-                    break;
+            },
+            |r, &t, c| {
+                let Some(c) = c else {
+                    return Wrote::Nothing;
+                };
+                if !r.apply_clean(t, c) {
+                    return Wrote::Nothing;
                 }
-                ok = self.collapse(a, b, hi * 1.25) || self.collapse(b, a, hi * 1.25);
-            }
-            // A needle whose short edge is too long for either end to move onto the other.
-            if !ok && self.middle {
-                let (_, a, b) = e[0];
-                ok = self.collapse_mid(a, b, hi * 1.25);
-            }
-            // A cap (an angle over 120°): split the edge opposite it.
-            if !ok && angles_deg(&self.corners(t)).1 > 120.0 {
-                let (_, a, b) = e[2];
-                ok = self.split(a, b);
-            }
-            if !ok {
-                for v in tri {
-                    ok |= self.relax(v);
-                }
-            }
-            if !ok {
-                self.clock += 1;
-                self.failed_at[t as usize] = self.clock;
-            }
-            done += ok as usize;
-        }
+                done += 1;
+                // A split or relaxation in the fallback may move corners: the box after too.
+                let tri = r.tris[t as usize];
+                Wrote::Also(r.fans_box(&tri))
+            },
+        );
         done
+    }
+
+    /// What [`Self::clean_up`] does to triangle `t`, as far as it can be checked without
+    /// changing the surface: `None` if `t` is left alone (gone, no longer below the target, or
+    /// failed before with nothing around it changed since); else the flips refused for no gain
+    /// (to remember) and the first flip or collapse that passes, if any.
+    fn check_clean(&self, t: u32, hi: f64) -> Option<Clean> {
+        if !self.alive[t as usize] || min_angle_deg(&self.corners(t)) >= self.target_angle {
+            return None;
+        }
+        if self.failed_at[t as usize] > self.changed_around(&self.tris[t as usize]) {
+            return None;
+        }
+        let e = self.edges_by(t, |a, b| self.len(a, b));
+        let mut no_gain = Vec::new();
+        for &(_, a, b) in e.iter().rev() {
+            match self.check_flip(a, b) {
+                Flip::NoGain(u, k) => no_gain.push((u, k)),
+                Flip::Refused => {}
+                f @ Flip::Do { .. } => {
+                    return Some(Clean {
+                        no_gain,
+                        op: Some(CleanOp::Flip(f)),
+                    });
+                }
+            }
+        }
+        let f = hi * 1.25;
+        let collapse = e
+            .iter()
+            .find_map(|&(_, a, b)| {
+                self.check_collapse(a, b, false, f)
+                    .or_else(|| self.check_collapse(b, a, false, f))
+            })
+            // A needle whose short edge is too long for either end to move onto the other.
+            .or_else(|| {
+                let (_, a, b) = e[0];
+                self.middle
+                    .then(|| self.check_collapse(a, b, true, f))
+                    .flatten()
+            });
+        Some(Clean {
+            no_gain,
+            op: collapse.map(CleanOp::Collapse),
+        })
+    }
+
+    /// Apply what [`Self::check_clean`] found for `t`, then what cannot be checked ahead: a
+    /// cap's split, the corners' relaxation; whether anything changed.
+    fn apply_clean(&mut self, t: u32, c: Clean) -> bool {
+        for (u, k) in c.no_gain {
+            self.apply_flip(Flip::NoGain(u, k));
+        }
+        let mut ok = match c.op {
+            Some(CleanOp::Flip(f)) => self.apply_flip(f),
+            Some(CleanOp::Collapse(c)) => {
+                self.apply_collapse(c);
+                true
+            }
+            None => false,
+        };
+        let tri = self.tris[t as usize];
+        // A cap (an angle over 120°): split the edge opposite it.
+        if !ok && angles_deg(&self.corners(t)).1 > 120.0 {
+            let (_, a, b) = self.edges_by(t, |a, b| self.len(a, b))[2];
+            ok = self.split(a, b);
+        }
+        if !ok {
+            for v in tri {
+                ok |= self.relax(v);
+            }
+        }
+        if !ok {
+            self.clock += 1;
+            self.failed_at[t as usize] = self.clock;
+        }
+        ok
     }
 
     /// Points to move or split where the output strays from the input: split the longest

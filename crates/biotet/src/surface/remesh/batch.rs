@@ -32,6 +32,16 @@ pub(super) fn grow(b: Boxed, r: f64) -> Boxed {
     (b.0.map(|x| x - r), b.1.map(|x| x + r))
 }
 
+/// What applying an item changed.
+pub(super) enum Wrote {
+    /// Nothing another item reads (at most a note of its own refusal).
+    Nothing,
+    /// The surface, within the box the check read grown by [`Remesher::reach`].
+    Read,
+    /// That and also within this box grown by the reach (points moved beyond what was read).
+    Also(Boxed),
+}
+
 /// The boxes written in a batch, in a [`Grid`] by the cells they cover.
 pub(super) struct Taken {
     boxes: Vec<Boxed>,
@@ -108,12 +118,12 @@ impl Remesher<'_> {
 
     /// For each item in order, `apply(self, item, check(self, item))`, with the checks of a
     /// batch run in parallel (module docs). `check` returns the box it read with its outcome;
-    /// `apply` whether it wrote. Returns the number of items checked again.
+    /// `apply` what it wrote ([`Wrote`]). Returns the number of items checked again.
     pub(super) fn in_batches<T: Sync, R: Send>(
         &mut self,
         items: &[T],
         check: impl Fn(&Self, &T) -> (Boxed, R) + Sync,
-        mut apply: impl FnMut(&mut Self, &T, R) -> bool,
+        mut apply: impl FnMut(&mut Self, &T, R) -> Wrote,
     ) -> usize {
         let reach = self.reach();
         let mut taken = Taken::new(4.0 * self.l + 4.0 * reach);
@@ -133,8 +143,13 @@ impl Remesher<'_> {
                 } else {
                     (read, r)
                 };
-                if apply(self, x, r) {
-                    taken.add(grow(read, reach));
+                match apply(self, x, r) {
+                    Wrote::Nothing => {}
+                    Wrote::Read => taken.add(grow(read, reach)),
+                    Wrote::Also(more) => {
+                        taken.add(grow(read, reach));
+                        taken.add(grow(more, reach));
+                    }
                 }
             }
         }
@@ -145,6 +160,7 @@ impl Remesher<'_> {
 #[cfg(test)]
 mod tests {
     use super::super::tests::Fixture;
+    use super::super::{angles_deg, min_angle_deg};
     use crate::surface::{median_edge_length, tests::uv_sphere};
 
     /// Collapsing in batches leaves the surface that collapsing one edge at a time in the same
@@ -199,5 +215,85 @@ mod tests {
             |p: &[[f64; 3]]| -> Vec<[u64; 3]> { p.iter().map(|x| x.map(f64::to_bits)).collect() };
         assert_eq!(bits(&batched.pts), bits(&serial.pts));
         assert_eq!(batched.cover, serial.cover);
+    }
+
+    /// The clean-up in batches leaves the surface that treating one triangle at a time leaves
+    /// (the loop as it was before batches, below): on a sphere of needles and caps at its
+    /// poles, with and without middle collapses, to the bit.
+    #[test]
+    fn the_batched_clean_up_ends_as_one_at_a_time() {
+        let s = uv_sphere(1.0, [0.0; 3], 96, 12);
+        let l = median_edge_length(&s);
+        let d = 0.02;
+        let fx = Fixture::new(&s, d, l);
+        let mut batched = fx.remesher(&s, d, l);
+        let mut serial = fx.remesher(&s, d, l);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .expect("pool");
+        let mut done = 0;
+        for middle in [false, true] {
+            batched.middle = middle;
+            serial.middle = middle;
+            for _ in 0..3 {
+                done += pool.install(|| batched.clean_up());
+                one_at_a_time(&mut serial);
+            }
+        }
+        assert!(done > 50, "{done}: the clean-up did little");
+        assert_eq!(batched.counts, serial.counts);
+        assert_eq!(batched.tris, serial.tris);
+        assert_eq!(batched.alive, serial.alive);
+        let bits =
+            |p: &[[f64; 3]]| -> Vec<[u64; 3]> { p.iter().map(|x| x.map(f64::to_bits)).collect() };
+        assert_eq!(bits(&batched.pts), bits(&serial.pts));
+        assert_eq!(batched.cover, serial.cover);
+    }
+
+    /// [`Remesher::clean_up`] one triangle at a time.
+    fn one_at_a_time(r: &mut super::Remesher) {
+        let hi = 4.0 / 3.0;
+        let bad: Vec<u32> = (0..r.tris.len() as u32)
+            .filter(|&t| r.alive[t as usize] && min_angle_deg(&r.corners(t)) < r.target_angle)
+            .collect();
+        if r.failed_middle != r.middle {
+            r.failed_middle = r.middle;
+            r.failed_at.fill(0);
+        }
+        for t in bad {
+            if !r.alive[t as usize] || min_angle_deg(&r.corners(t)) >= r.target_angle {
+                continue;
+            }
+            if r.failed_at[t as usize] > r.changed_around(&r.tris[t as usize]) {
+                continue;
+            }
+            let tri = r.tris[t as usize];
+            let e = r.edges_by(t, |a, b| r.len(a, b));
+            let mut ok = e.iter().rev().any(|&(_, a, b)| r.flip(a, b));
+            for &(_, a, b) in &e {
+                if ok {
+                    break;
+                }
+                ok = r.collapse(a, b, hi * 1.25) || r.collapse(b, a, hi * 1.25);
+            }
+            if !ok && r.middle {
+                let (_, a, b) = e[0];
+                ok = r.collapse_mid(a, b, hi * 1.25);
+            }
+            if !ok && angles_deg(&r.corners(t)).1 > 120.0 {
+                let (_, a, b) = e[2];
+                ok = r.split(a, b);
+            }
+            if !ok {
+                for v in tri {
+                    ok |= r.relax(v);
+                }
+            }
+            if !ok {
+                r.clock += 1;
+                r.failed_at[t as usize] = r.clock;
+            }
+        }
     }
 }
