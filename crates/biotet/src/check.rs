@@ -6,6 +6,7 @@
 
 use crate::geom::predicates::{Sign, in_exact_range, orient3d};
 use crate::mesh::coord_key;
+use crate::mesh::dsu::Dsu;
 use crate::mesh::surface::SurfaceMesh;
 use crate::mesh::tet::{NO_NEIGHBOR, TET_FACES, TetMesh, sorted3};
 use crate::mesh::validate::{
@@ -457,25 +458,17 @@ fn touching_boundary(
     let np = mesh.points.len();
     let corner = |t: usize, v: u32| mesh.tets[t].iter().position(|&x| x == v).unwrap_or(0);
     // Tet corners 4t + i joined across interior faces at each of the face's vertices.
-    let mut dsu: Vec<u32> = (0..4 * nt as u32).collect();
-    fn find(p: &mut [u32], mut x: u32) -> u32 {
-        while p[x as usize] != x {
-            p[x as usize] = p[p[x as usize] as usize];
-            x = p[x as usize];
-        }
-        x
-    }
+    let mut dsu = Dsu::new(4 * nt);
     for w in face_keys.windows(2) {
         if w[0].0 != w[1].0 {
             continue;
         }
         let (ta, tb) = ((w[0].1 >> 2) as usize, (w[1].1 >> 2) as usize);
         for v in w[0].0 {
-            let a = find(&mut dsu, (4 * ta + corner(ta, v)) as u32);
-            let b = find(&mut dsu, (4 * tb + corner(tb, v)) as u32);
-            if a != b {
-                dsu[a.max(b) as usize] = a.min(b);
-            }
+            dsu.union(
+                (4 * ta + corner(ta, v)) as u32,
+                (4 * tb + corner(tb, v)) as u32,
+            );
         }
     }
     // (vertex, class, label) of every corner; per vertex, classes sharing a label merged.
@@ -483,7 +476,7 @@ fn touching_boundary(
         .map(|c| {
             let t = c / 4;
             let label = mesh.labels.get(t).copied().unwrap_or(0);
-            (mesh.tets[t][c % 4], find(&mut dsu, c as u32), label)
+            (mesh.tets[t][c % 4], dsu.find(c as u32), label)
         })
         .collect();
     at.sort_unstable();
@@ -552,7 +545,7 @@ fn touching_boundary(
         .map(|(k, &(t, f))| {
             let t = t as usize;
             let mut tri = mesh.face(t, f as usize).map(|v| {
-                let class = find(&mut dsu, (4 * t + corner(t, v)) as u32);
+                let class = dsu.find((4 * t + corner(t, v)) as u32);
                 copy_of.get(&class).copied().unwrap_or(v)
             });
             if let Some(r) = (0..3).find(|&r| !touching[tri[r] as usize]) {

@@ -11,6 +11,7 @@
 use crate::geom::filter::orient3d;
 use crate::geom::intersect::{drop_axis, projection_axis};
 use crate::geom::predicates::{Sign, orient2d};
+use crate::mesh::dsu::Dsu;
 use std::cmp::Ordering;
 
 type P3 = [f64; 3];
@@ -33,27 +34,11 @@ struct Wing {
 #[derive(Debug, Default)]
 pub(crate) struct Cells {
     wings: Vec<Wing>,
-    parent: Vec<u32>,
+    parent: Dsu,
     group: Vec<Wing>,
     /// The wings of `group` with their angle class, for sorting.
     classed: Vec<(u8, Wing)>,
     root_cell: Vec<u32>,
-}
-
-fn find(parent: &mut [u32], mut x: u32) -> u32 {
-    while parent[x as usize] != x {
-        let p = parent[parent[x as usize] as usize];
-        parent[x as usize] = p;
-        x = p;
-    }
-    x
-}
-
-fn union(parent: &mut [u32], a: u32, b: u32) {
-    let (ra, rb) = (find(parent, a), find(parent, b));
-    if ra != rb {
-        parent[ra.max(rb) as usize] = ra.min(rb);
-    }
 }
 
 impl Cells {
@@ -79,8 +64,7 @@ impl Cells {
             }
         }
         self.wings.sort_unstable_by_key(|w| (w.edge, w.face));
-        self.parent.clear();
-        self.parent.extend(0..faces.len() as u32);
+        self.parent.reset(faces.len());
         let mut i = 0;
         while i < self.wings.len() {
             let mut j = i + 1;
@@ -92,7 +76,7 @@ impl Cells {
                 if x.forward == y.forward {
                     return Err(x.edge);
                 }
-                union(&mut self.parent, x.face, y.face);
+                self.parent.union(x.face, y.face);
             } else {
                 self.group.clear();
                 self.group.extend_from_slice(&self.wings[i..j]);
@@ -101,7 +85,7 @@ impl Cells {
                 for k in 0..m {
                     let (h, nx) = (self.group[k], self.group[(k + 1) % m]);
                     match (h.forward, nx.forward) {
-                        (true, false) => union(&mut self.parent, h.face, nx.face),
+                        (true, false) => self.parent.union(h.face, nx.face),
                         (false, true) => {}
                         _ => return Err(h.edge),
                     }
@@ -115,7 +99,7 @@ impl Cells {
         root_cell.resize(faces.len(), u32::MAX);
         let mut n = 0;
         for f in 0..faces.len() {
-            let r = find(&mut self.parent, f as u32) as usize;
+            let r = self.parent.find(f as u32) as usize;
             if root_cell[r] == u32::MAX {
                 root_cell[r] = n;
                 n += 1;

@@ -2,12 +2,19 @@
 //! numbering taken from them) do not depend on the order of the unions.
 
 /// Disjoint sets of `0..n`.
+#[derive(Debug, Clone, Default)]
 pub(crate) struct Dsu(Vec<u32>);
 
 impl Dsu {
     /// `n` singletons.
     pub(crate) fn new(n: usize) -> Dsu {
         Dsu((0..n as u32).collect())
+    }
+
+    /// Make it `n` singletons again, keeping the allocation.
+    pub(crate) fn reset(&mut self, n: usize) {
+        self.0.clear();
+        self.0.extend(0..n as u32);
     }
 
     /// The root of `x`'s set (its smallest member), halving the path on the way.

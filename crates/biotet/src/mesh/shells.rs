@@ -21,6 +21,7 @@
 //! refused; a non-manifold part must be the only part.
 //! [`crate::mesh::validate`] checks the result (closed regions, no intersections).
 
+use crate::mesh::dsu::Dsu;
 use rustc_hash::FxHashMap;
 
 use crate::geom::vec3::volume6;
@@ -99,26 +100,14 @@ pub struct Part {
 
 /// Connected components of triangles through shared edges: component of each triangle, count.
 fn components(tris: &[[u32; 3]]) -> (Vec<u32>, usize) {
-    let mut parent: Vec<u32> = (0..tris.len() as u32).collect();
-    fn find(p: &mut [u32], mut x: u32) -> u32 {
-        while p[x as usize] != x {
-            p[x as usize] = p[p[x as usize] as usize];
-            x = p[x as usize];
-        }
-        x
-    }
+    let mut parent = Dsu::new(tris.len());
     let mut first: FxHashMap<(u32, u32), u32> = Default::default();
     for (t, tri) in tris.iter().enumerate() {
         for k in 0..3 {
             let (a, b) = (tri[k], tri[(k + 1) % 3]);
             let e = (a.min(b), a.max(b));
             match first.get(&e) {
-                Some(&u) => {
-                    let (x, y) = (find(&mut parent, u), find(&mut parent, t as u32));
-                    if x != y {
-                        parent[x.max(y) as usize] = x.min(y);
-                    }
-                }
+                Some(&u) => parent.union(u, t as u32),
                 None => {
                     first.insert(e, t as u32);
                 }
@@ -129,7 +118,7 @@ fn components(tris: &[[u32; 3]]) -> (Vec<u32>, usize) {
     let mut comp = vec![0u32; tris.len()];
     let mut n = 0;
     for (t, c) in comp.iter_mut().enumerate() {
-        let r = find(&mut parent, t as u32) as usize;
+        let r = parent.find(t as u32) as usize;
         if id[r] == u32::MAX {
             id[r] = n;
             n += 1;
@@ -509,13 +498,7 @@ pub fn touching(s: &SurfaceMesh) -> Touching {
     let mut out = Touching::default();
     let mut on_edge: rustc_hash::FxHashSet<u32> = Default::default();
     // Fans: corners (3t + k) of outer triangles joined across edges with two outer triangles.
-    let mut parent: FxHashMap<usize, usize> = Default::default();
-    fn find(p: &mut FxHashMap<usize, usize>, mut x: usize) -> usize {
-        while let Some(&y) = p.get(&x).filter(|&&y| y != x) {
-            x = y;
-        }
-        x
-    }
+    let mut parent = Dsu::new(3 * s.triangles.len());
     let corner =
         |t: usize, v: u32| 3 * t + s.triangles[t].iter().position(|&x| x == v).unwrap_or(0);
     let mut edges: Vec<_> = at_edge.into_iter().collect();
@@ -524,11 +507,7 @@ pub fn touching(s: &SurfaceMesh) -> Touching {
         match ts.len() {
             2 => {
                 for v in e {
-                    let a = find(&mut parent, corner(ts[0], *v));
-                    let b = find(&mut parent, corner(ts[1], *v));
-                    if a != b {
-                        parent.insert(a.max(b), a.min(b));
-                    }
+                    parent.union(corner(ts[0], *v) as u32, corner(ts[1], *v) as u32);
                 }
             }
             n if n > 2 => {
@@ -541,7 +520,7 @@ pub fn touching(s: &SurfaceMesh) -> Touching {
     let mut fans: Vec<(u32, usize, usize)> = Vec::new(); // (vertex, fan, triangle)
     for &t in &outer {
         for v in s.triangles[t] {
-            fans.push((v, find(&mut parent, corner(t, v)), t));
+            fans.push((v, parent.find(corner(t, v) as u32) as usize, t));
         }
     }
     fans.sort_unstable();

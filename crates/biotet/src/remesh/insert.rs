@@ -22,6 +22,7 @@ use crate::geom::intersect::{SegTri, seg_tri, triangles_meet};
 use crate::geom::predicates::{Sign, orient3d};
 use crate::geom::vec3::bbox;
 use crate::geom::vec3::{add, cross, dot, scale, sub};
+use crate::mesh::dsu::Dsu;
 use crate::mesh::inside::{Location, RegionLocator};
 use crate::mesh::surface::SurfaceMesh;
 use crate::mesh::tet::{NO_NEIGHBOR, TET_FACES, TetMesh};
@@ -148,24 +149,13 @@ impl<'a> SurfaceIndex<'a> {
         }
         let bvh = Bvh::new(tris, (0..nt as u32).collect());
         // Components through shared points (union-find on points).
-        let mut parent: Vec<u32> = (0..s.points.len() as u32).collect();
-        fn find(p: &mut [u32], mut x: u32) -> u32 {
-            while p[x as usize] != x {
-                p[x as usize] = p[p[x as usize] as usize];
-                x = p[x as usize];
-            }
-            x
-        }
+        let mut parent = Dsu::new(s.points.len());
         for t in &s.triangles {
-            for k in 1..3 {
-                let (a, b) = (find(&mut parent, t[0]), find(&mut parent, t[k]));
-                if a != b {
-                    parent[a.max(b) as usize] = a.min(b);
-                }
-            }
+            parent.union(t[0], t[1]);
+            parent.union(t[0], t[2]);
         }
         let seeds = (0..s.points.len() as u32)
-            .filter(|&v| find(&mut parent, v) == v)
+            .filter(|&v| parent.find(v) == v)
             .map(|v| (v as usize, s.points[v as usize]))
             .collect();
         SurfaceIndex {
