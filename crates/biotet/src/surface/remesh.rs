@@ -1152,11 +1152,9 @@ impl<'a> Remesher<'a> {
         self.relax_all();
     }
 
-    /// Collapse the edges shorter than `lo` times their target, shortest first, the new edges
-    /// no longer than `hi` times theirs; an edge refused both ways is not tried again while the
-    /// triangles at its ends stay. The checks run in batches ([`batch`]).
-    /// Returns the number of collapses checked again.
-    fn collapse_short(&mut self, lo: f64, hi: f64) -> usize {
+    /// The edges `(length / target, a, b)` shorter than `lo` times their target, shortest
+    /// first (ties by their points).
+    fn short_edges(&self, lo: f64) -> Vec<(f64, u32, u32)> {
         let mut short: Vec<(f64, u32, u32)> = self
             .edges()
             .into_iter()
@@ -1164,6 +1162,15 @@ impl<'a> Remesher<'a> {
             .filter(|e| e.0 < lo)
             .collect();
         short.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
+        short
+    }
+
+    /// Collapse the edges shorter than `lo` times their target, shortest first, the new edges
+    /// no longer than `hi` times theirs; an edge refused both ways is not tried again while the
+    /// triangles at its ends stay. The checks run in batches ([`batch`]).
+    /// Returns the number of collapses checked again.
+    fn collapse_short(&mut self, lo: f64, hi: f64) -> usize {
+        let short = self.short_edges(lo);
         self.in_batches(
             &short,
             |r, &(_, a, b)| {

@@ -18,7 +18,7 @@ use super::{Grid, P3, Remesher};
 const BATCH: usize = 128;
 
 /// Fewer items than this are checked on the calling thread.
-pub(super) const PARALLEL_STEP: usize = 8;
+const PARALLEL_STEP: usize = 8;
 
 /// An axis-aligned box.
 pub(super) type Boxed = (P3, P3);
@@ -123,10 +123,21 @@ impl Remesher<'_> {
         &mut self,
         items: &[T],
         check: impl Fn(&Self, &T) -> (Boxed, R) + Sync,
+        apply: impl FnMut(&mut Self, &T, R) -> Wrote,
+    ) -> usize {
+        let mut taken = Taken::new(4.0 * self.l + 4.0 * self.reach());
+        self.in_batches_with(items, &mut taken, check, apply)
+    }
+
+    /// [`Self::in_batches`] keeping the written boxes in `taken` (cleared at each batch).
+    pub(super) fn in_batches_with<T: Sync, R: Send>(
+        &mut self,
+        items: &[T],
+        taken: &mut Taken,
+        check: impl Fn(&Self, &T) -> (Boxed, R) + Sync,
         mut apply: impl FnMut(&mut Self, &T, R) -> Wrote,
     ) -> usize {
         let reach = self.reach();
-        let mut taken = Taken::new(4.0 * self.l + 4.0 * reach);
         let mut again = 0;
         for batch in items.chunks(BATCH) {
             let checked: Vec<(Boxed, R)> = if batch.len() >= PARALLEL_STEP {
@@ -158,9 +169,9 @@ impl Remesher<'_> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::super::tests::Fixture;
-    use super::super::{angles_deg, min_angle_deg};
+    use super::super::{Remesher, angles_deg, min_angle_deg};
     use crate::surface::{median_edge_length, tests::uv_sphere};
 
     /// Collapsing in batches leaves the surface that collapsing one edge at a time in the same
@@ -175,20 +186,9 @@ mod tests {
         let fx = Fixture::new(&s, d, l);
         let mut batched = fx.remesher(&s, d, l);
         let mut serial = fx.remesher(&s, d, l);
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(2)
-            .build()
-            .expect("pool");
-        let again = pool.install(|| batched.collapse_short(lo, hi));
+        let again = two_threads().install(|| batched.collapse_short(lo, hi));
         // The same list, one edge at a time.
-        let mut short: Vec<(f64, u32, u32)> = serial
-            .edges()
-            .into_iter()
-            .map(|(a, b)| (serial.rel(a, b), a, b))
-            .filter(|e| e.0 < lo)
-            .collect();
-        short.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
-        for (_, a, b) in short {
+        for (_, a, b) in serial.short_edges(lo) {
             let r = &mut serial;
             if r.vt[a as usize].is_empty()
                 || r.vt[b as usize].is_empty()
@@ -208,13 +208,27 @@ mod tests {
         }
         assert!(again > 0, "no collapse was checked again");
         assert!(batched.counts.collapses > 100, "{:?}", batched.counts);
-        assert_eq!(batched.counts, serial.counts);
-        assert_eq!(batched.tris, serial.tris);
-        assert_eq!(batched.alive, serial.alive);
+        assert_same(&batched, &serial);
+    }
+
+    /// A pool of two threads, so batches are checked in parallel.
+    pub(in super::super) fn two_threads() -> rayon::ThreadPool {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .expect("pool")
+    }
+
+    /// The two surfaces are the same to the bit, with the same operations done and the same
+    /// covers of the input samples.
+    pub(in super::super) fn assert_same(a: &Remesher, b: &Remesher) {
+        assert_eq!(a.counts, b.counts);
+        assert_eq!(a.tris, b.tris);
+        assert_eq!(a.alive, b.alive);
         let bits =
             |p: &[[f64; 3]]| -> Vec<[u64; 3]> { p.iter().map(|x| x.map(f64::to_bits)).collect() };
-        assert_eq!(bits(&batched.pts), bits(&serial.pts));
-        assert_eq!(batched.cover, serial.cover);
+        assert_eq!(bits(&a.pts), bits(&b.pts));
+        assert_eq!(a.cover, b.cover);
     }
 
     /// The clean-up in batches leaves the surface that treating one triangle at a time leaves
@@ -228,10 +242,7 @@ mod tests {
         let fx = Fixture::new(&s, d, l);
         let mut batched = fx.remesher(&s, d, l);
         let mut serial = fx.remesher(&s, d, l);
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(2)
-            .build()
-            .expect("pool");
+        let pool = two_threads();
         let mut done = 0;
         for middle in [false, true] {
             batched.middle = middle;
@@ -242,17 +253,11 @@ mod tests {
             }
         }
         assert!(done > 50, "{done}: the clean-up did little");
-        assert_eq!(batched.counts, serial.counts);
-        assert_eq!(batched.tris, serial.tris);
-        assert_eq!(batched.alive, serial.alive);
-        let bits =
-            |p: &[[f64; 3]]| -> Vec<[u64; 3]> { p.iter().map(|x| x.map(f64::to_bits)).collect() };
-        assert_eq!(bits(&batched.pts), bits(&serial.pts));
-        assert_eq!(batched.cover, serial.cover);
+        assert_same(&batched, &serial);
     }
 
     /// [`Remesher::clean_up`] one triangle at a time.
-    fn one_at_a_time(r: &mut super::Remesher) {
+    fn one_at_a_time(r: &mut Remesher) {
         let hi = 4.0 / 3.0;
         let bad: Vec<u32> = (0..r.tris.len() as u32)
             .filter(|&t| r.alive[t as usize] && min_angle_deg(&r.corners(t)) < r.target_angle)

@@ -11,9 +11,7 @@
 //! time in this order gives, on any number of threads ([`super::batch`] does the same for an
 //! ordered list of operations).
 
-use rayon::prelude::*;
-
-use super::batch::{Boxed, PARALLEL_STEP, Taken, grow};
+use super::batch::{Boxed, Taken, Wrote, grow};
 use super::{Move, P3, Remesher};
 
 impl Remesher<'_> {
@@ -25,7 +23,19 @@ impl Remesher<'_> {
         let mut taken = Taken::new(cube / 4.0);
         let mut again = 0;
         for step in self.steps(cube) {
-            again += self.relax_step(&step, reach, &mut taken);
+            // Checked in parallel, applied in order ([`super::batch`]).
+            again += self.in_batches_with(
+                &step,
+                &mut taken,
+                |r, &v| r.checked_relax(v, reach),
+                |r, _, m| match m {
+                    Some(m) => {
+                        r.apply_move(m);
+                        Wrote::Read
+                    }
+                    None => Wrote::Nothing,
+                },
+            );
         }
         again
     }
@@ -75,35 +85,6 @@ impl Remesher<'_> {
         steps
     }
 
-    /// Check the moves of the points of `step` in parallel, then apply them in order.
-    fn relax_step(&mut self, step: &[u32], reach: f64, taken: &mut Taken) -> usize {
-        let checked: Vec<(Boxed, Option<Move>)> = if step.len() >= PARALLEL_STEP {
-            let this = &*self;
-            step.par_iter()
-                .map(|&v| this.checked_relax(v, reach))
-                .collect()
-        } else {
-            step.iter().map(|&v| self.checked_relax(v, reach)).collect()
-        };
-        taken.clear();
-        let mut again = 0;
-        for (&v, (read, m)) in step.iter().zip(checked) {
-            let (read, m) = if taken.meets(&read) {
-                again += 1;
-                self.checked_relax(v, reach)
-            } else {
-                (read, m)
-            };
-            if let Some(m) = m {
-                // What the move changes reaches a tolerance farther than what it read (the
-                // samples it hands to triangles near its fan).
-                taken.add(grow(read, reach));
-                self.apply_move(m);
-            }
-        }
-        again
-    }
-
     /// [`Self::check_relax`] with the box its checks read: the fan's corners and the new
     /// place, grown by `reach`.
     fn checked_relax(&self, v: u32, reach: f64) -> (Boxed, Option<Move>) {
@@ -131,6 +112,7 @@ impl Remesher<'_> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::batch::tests::{assert_same, two_threads};
     use super::super::tests::Fixture;
     use crate::surface::{median_edge_length, tests::uv_sphere};
 
@@ -145,10 +127,7 @@ mod tests {
         let fx = Fixture::new(&s, d, l);
         let mut swept = fx.remesher(&s, d, l);
         let mut serial = fx.remesher(&s, d, l);
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(2)
-            .build()
-            .expect("pool");
+        let pool = two_threads();
         let mut again = 0;
         for _ in 0..3 {
             let reach = serial.tol * (1.0 + 1e-6);
@@ -161,9 +140,6 @@ mod tests {
         }
         assert!(again > 0, "no move was checked again");
         assert!(swept.counts.moves > 0);
-        assert_eq!(swept.counts, serial.counts);
-        let bits =
-            |p: &[[f64; 3]]| -> Vec<[u64; 3]> { p.iter().map(|x| x.map(f64::to_bits)).collect() };
-        assert_eq!(bits(&swept.pts), bits(&serial.pts));
+        assert_same(&swept, &serial);
     }
 }
