@@ -128,6 +128,8 @@ struct Clean {
     op: Option<CleanOp>,
 }
 
+/// The operation [`Remesher::check_clean`] found for a triangle: a flip ([`Flip::Do`]) or a
+/// collapse.
 enum CleanOp {
     Flip(Flip),
     Collapse(Collapse),
