@@ -12,7 +12,7 @@
 //! ordered list of operations).
 
 use super::batch::{Boxed, Taken, Wrote, grow};
-use super::{Move, P3, Remesher};
+use super::{Move, Remesher};
 
 impl Remesher<'_> {
     /// Relax every point once ([`Self::relax`]), in the order of the module's steps; the number
@@ -27,7 +27,7 @@ impl Remesher<'_> {
             again += self.in_batches_with(
                 &step,
                 &mut taken,
-                |r, &v| r.checked_relax(v, reach),
+                |r, &v| r.checked_relax(v),
                 |r, _, m| match m {
                     Some(m) => {
                         r.apply_move(m);
@@ -86,27 +86,22 @@ impl Remesher<'_> {
     }
 
     /// [`Self::check_relax`] with the box its checks read: the fan's corners and the new
-    /// place, grown by `reach`.
-    fn checked_relax(&self, v: u32, reach: f64) -> (Boxed, Option<Move>) {
+    /// place, grown by [`Self::reach`].
+    fn checked_relax(&self, v: u32) -> (Boxed, Option<Move>) {
         let target = self.relax_target(v);
         let m = target.and_then(|(x, h)| self.check_move(v, x, Some(h)));
-        let mut lo = self.pts[v as usize];
-        let mut hi = lo;
-        let mut take = |p: P3| {
-            for k in 0..3 {
-                lo[k] = lo[k].min(p[k]);
-                hi[k] = hi[k].max(p[k]);
+        let fans = self.fans_box(&[v]);
+        let read = match target {
+            Some((x, _)) => {
+                let (lo, hi) = grow((x, x), self.reach());
+                (
+                    [0, 1, 2].map(|k| fans.0[k].min(lo[k])),
+                    [0, 1, 2].map(|k| fans.1[k].max(hi[k])),
+                )
             }
+            None => fans,
         };
-        for &t in &self.vt[v as usize] {
-            for u in self.tris[t as usize] {
-                take(self.pts[u as usize]);
-            }
-        }
-        if let Some((x, _)) = target {
-            take(x);
-        }
-        (grow((lo, hi), reach), m)
+        (read, m)
     }
 }
 
