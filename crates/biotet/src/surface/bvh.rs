@@ -30,6 +30,8 @@ pub struct Closest {
     pub point: P3,
     /// Index of the triangle it lies on (in the order the triangles were given).
     pub triangle: u32,
+    /// That triangle's place in the hierarchy ([`Bvh::slot`]).
+    pub slot: u32,
 }
 
 /// The triangles that answered a caller's last few [`Bvh::any_within_hinted`] queries, latest
@@ -314,6 +316,7 @@ impl Bvh {
             d2: max_d2,
             point: p,
             triangle: u32::MAX,
+            slot: u32::MAX,
         };
         let mut stack = NodeStack::root();
         while let Some(i) = stack.pop() {
@@ -330,6 +333,7 @@ impl Bvh {
                             d2: d,
                             point: q,
                             triangle: self.ids[k as usize],
+                            slot: k,
                         };
                     }
                 }
@@ -371,6 +375,16 @@ impl Bvh {
     /// The squared distance to the first triangle [`Self::any_within_hinted`] finds within
     /// `sqrt(r2)` of `p`: an upper bound on the distance to the set, found as cheaply.
     pub fn first_within_hinted(&self, p: P3, r2: f64, hint: &mut Hint) -> Option<f64> {
+        self.first_within_slot(p, r2, hint).map(|x| x.0)
+    }
+
+    /// The corners of the triangle in place `k` of the hierarchy ([`Closest::slot`]).
+    pub fn slot(&self, k: u32) -> &[P3; 3] {
+        &self.tris[k as usize]
+    }
+
+    /// [`Self::first_within_hinted`] with the place of the triangle found ([`Self::slot`]).
+    pub fn first_within_slot(&self, p: P3, r2: f64, hint: &mut Hint) -> Option<(f64, u32)> {
         if self.nodes.is_empty() {
             return None;
         }
@@ -383,7 +397,7 @@ impl Bvh {
             if let Some(d2) = within_d2_pre(p, &self.tris[k as usize], &self.pre[k as usize], r, r2)
             {
                 hint.note(k);
-                return Some(d2);
+                return Some((d2, k));
             }
         }
         let mut stack = NodeStack::root();
@@ -397,7 +411,7 @@ impl Bvh {
                     let (t, pre) = (&self.tris[k as usize], &self.pre[k as usize]);
                     if let Some(d2) = within_d2_pre(p, t, pre, r, r2) {
                         hint.note(k);
-                        return Some(d2);
+                        return Some((d2, k));
                     }
                 }
             } else {

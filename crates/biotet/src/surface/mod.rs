@@ -118,7 +118,9 @@ pub struct SurfaceReport {
     /// Largest sampled distance from the output to the input.
     pub hausdorff_out_to_in: f64,
     /// Upper bound on the true two-sided distance (sampled maximum plus the samples' covering
-    /// radius; the distance to a surface is 1-Lipschitz).
+    /// radius, the distance to a surface being 1-Lipschitz; or where that is over the tolerance,
+    /// per grid cell its corners' largest distance to one triangle, the distance to a triangle
+    /// being convex: [`hausdorff::Sided::bound`]).
     pub hausdorff_bound: f64,
     /// Spacing of the samples of the final measure.
     pub sample_spacing: f64,

@@ -248,15 +248,13 @@ fn the_final_measure_lists_what_lies_beyond_the_tolerance() {
     assert!(oi.far.is_empty() && io.far.is_empty());
     assert!(oi.max > 0.04 && oi.max <= 0.05 + 1e-12, "{}", oi.max);
     // A tolerance just over the farthest sample, closer than the finest samples' covering
-    // radius: no sample is beyond it, but nothing proves it, so the bump is listed too.
-    let d = oi.max + 0.05 * (0.01 / 32.0);
+    // radius (0.01 / 32 / √3): the samples alone cannot prove it, but every cell's corners are
+    // within it of one input triangle, and the distance to a triangle is convex, so the bump is
+    // proven within it and not listed.
+    let d = oi.max + 1e-6;
     let (oi, _) = final_measure(&input, &out, &index, 0.01, d);
-    assert!(oi.max <= d && oi.bound > d, "{} {}", oi.max, oi.bound);
-    assert!(!oi.far.is_empty());
-    for f in &oi.far {
-        assert!(f.distance <= d);
-        assert!(out.triangles[f.triangle as usize].contains(&40), "{f:?}");
-    }
+    assert!(oi.max <= d && oi.bound <= d, "{} {}", oi.max, oi.bound);
+    assert!(oi.far.is_empty());
 }
 
 /// A flat tetrahedron's triangles have usable angles (20°–70°) but fold onto each other at its
