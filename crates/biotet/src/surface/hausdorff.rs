@@ -150,9 +150,11 @@ pub fn one_sided(
         far: Option<Far>,
         n: usize,
     }
+    // Per grid point, row by row: an upper bound on its distance and the other surface's
+    // triangle (slot) within it, if one was found (one buffer a job, not one a triangle).
     let per: Vec<Per> = (0..tris.len())
         .into_par_iter()
-        .map(|t| {
+        .map_init(Vec::new, |grid: &mut Vec<(f64, u32)>, t| {
             if alive.is_some_and(|a| !a[t]) {
                 return Per {
                     max: 0.0,
@@ -180,9 +182,6 @@ pub fn one_sided(
             let mut count = 0;
             let mut hint = Hint::default();
             let fine_n = ((longest / fine).ceil() as usize).max(1);
-            // Per grid point, row by row: an upper bound on its distance and the other
-            // surface's triangle (slot) within it, if one was found.
-            let mut grid: Vec<(f64, u32)> = Vec::new();
             let bound = 'again: loop {
                 grid.clear();
                 for i in 0..=n {
@@ -228,7 +227,7 @@ pub fn one_sided(
                 let step = longest / n as f64;
                 let mut bound = max + covering(step);
                 if bound > limit {
-                    bound = cells_bound(bvh, &c, n, step, &grid, limit);
+                    bound = cells_bound(bvh, &c, n, step, grid, limit);
                 }
                 // Refine just enough for the bound to prove the limit (if it can).
                 if bound > limit && fine_n > n && max < limit {

@@ -1341,7 +1341,7 @@ impl<'a> Remesher<'a> {
         for (u, k) in c.no_gain {
             self.apply_flip(Flip::NoGain(u, k));
         }
-        let mut ok = match c.op {
+        let ok = match c.op {
             Some(CleanOp::Flip(f)) => self.apply_flip(f),
             Some(CleanOp::Collapse(c)) => {
                 self.apply_collapse(c);
@@ -1349,9 +1349,20 @@ impl<'a> Remesher<'a> {
             }
             None => false,
         };
+        self.clean_rest(t, ok)
+    }
+
+    /// The clean-up's last resorts for triangle `t` when its flips and collapses did nothing
+    /// (`done` false): a cap's split, else its corners' relaxation, else `t` is marked failed
+    /// until a triangle at its corners changes. Whether anything changed.
+    fn clean_rest(&mut self, t: u32, done: bool) -> bool {
+        if done {
+            return true;
+        }
         let tri = self.tris[t as usize];
         // A cap (an angle over 120°): split the edge opposite it.
-        if !ok && angles_deg(&self.corners(t)).1 > 120.0 {
+        let mut ok = false;
+        if angles_deg(&self.corners(t)).1 > 120.0 {
             let (_, a, b) = self.edges_by(t, |a, b| self.len(a, b))[2];
             ok = self.split(a, b);
         }

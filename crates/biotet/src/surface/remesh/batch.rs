@@ -171,7 +171,7 @@ impl Remesher<'_> {
 #[cfg(test)]
 pub(super) mod tests {
     use super::super::tests::Fixture;
-    use super::super::{Remesher, angles_deg, min_angle_deg};
+    use super::super::{Remesher, min_angle_deg};
     use crate::surface::{median_edge_length, tests::uv_sphere};
 
     /// Collapsing in batches leaves the surface that collapsing one edge at a time in the same
@@ -273,7 +273,8 @@ pub(super) mod tests {
             if r.failed_at[t as usize] > r.changed_around(&r.tris[t as usize]) {
                 continue;
             }
-            let tri = r.tris[t as usize];
+            // The flips and collapses one at a time (what the batches check ahead); the last
+            // resorts are applied as they come in either way.
             let e = r.edges_by(t, |a, b| r.len(a, b));
             let mut ok = e.iter().rev().any(|&(_, a, b)| r.flip(a, b));
             for &(_, a, b) in &e {
@@ -286,19 +287,7 @@ pub(super) mod tests {
                 let (_, a, b) = e[0];
                 ok = r.collapse_mid(a, b, hi * 1.25);
             }
-            if !ok && angles_deg(&r.corners(t)).1 > 120.0 {
-                let (_, a, b) = e[2];
-                ok = r.split(a, b);
-            }
-            if !ok {
-                for v in tri {
-                    ok |= r.relax(v);
-                }
-            }
-            if !ok {
-                r.clock += 1;
-                r.failed_at[t as usize] = r.clock;
-            }
+            r.clean_rest(t, ok);
         }
     }
 }
