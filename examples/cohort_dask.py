@@ -46,10 +46,19 @@ def subject_name(path: str) -> str:
     return Path(name).stem
 
 
-def mesh_one(path: str, out_dir: str, options: dict) -> dict:
-    """Mesh one subject, write ``<subject>.vtu`` and ``<subject>.json``, return its summary
-    row. Never raises for a subject's own failure: the row says what went wrong."""
-    name = subject_name(path)
+def subject_names(paths: list[str]) -> list[str]:
+    """One distinct name per input, for its output files: the file name without its
+    extension(s); where two inputs share it (``s1/brain.stl``, ``s2/brain.stl``), their folder's
+    name before it (``s1_brain``), and where that is shared too, the input's position after it.
+    Two subjects never write to the same file."""
+    names = [subject_name(p) for p in paths]
+    names = [f"{Path(p).parent.name}_{n}" if names.count(n) > 1 else n for p, n in zip(paths, names)]
+    return [f"{n}_{i}" if names.count(n) > 1 else n for i, n in enumerate(names)]
+
+
+def mesh_one(path: str, name: str, out_dir: str, options: dict) -> dict:
+    """Mesh one subject, write ``<name>.vtu`` and ``<name>.json``, return its summary row.
+    Never raises for a subject's own failure: the row says what went wrong."""
     row = {k: "" for k in SUMMARY_FIELDS}
     row["subject"] = name
     start = time.perf_counter()
@@ -126,8 +135,8 @@ def main(argv: list[str] | None = None) -> int:
                                dashboard_address=None)
         client = Client(cluster)
     try:
-        futures = [client.submit(mesh_one, p, str(out), options, key=f"mesh-{i}-{subject_name(p)}")
-                   for i, p in enumerate(inputs)]
+        futures = [client.submit(mesh_one, p, name, str(out), options, key=f"mesh-{i}-{name}")
+                   for i, (p, name) in enumerate(zip(inputs, subject_names(inputs)))]
         rows = client.gather(futures)
     finally:
         client.close()

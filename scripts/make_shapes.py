@@ -17,11 +17,12 @@ Four sources, one prefix each (the list is SHAPES below; tests/data/shapes/READM
           cubes with grid- and fan-tessellated faces (many coplanar and cocircular points), a cube rotated by an
           irrational angle, a cube with a hole, and two cubes touching along an edge / at a vertex (two shells, one file).
 
-Every file is OFF: exactly equal points welded, unused points dropped, coordinates written with Python's repr (the
-shortest decimal that reads back to the same double), so every reader gets the same doubles. Every shape is then checked
-by `biotet validate`; a shape it refuses is not written (unless its name starts with `invalid_`) and is listed in the
-README with the validator's message. The output is deterministic for the pinned versions (PINNED); other versions are
-used with a warning, and the README records the versions that made the files.
+Every file is OFF: exactly equal points welded, unused points dropped (cad_loft_stray_nodes keeps them: its point),
+coordinates written with Python's repr (the shortest decimal that reads back to the same double), so every reader gets
+the same doubles. Every shape is then checked by `biotet validate`; a shape it refuses is not written (unless its name
+starts with `invalid_`) and is listed in the README with the validator's message. The output is deterministic for the
+pinned versions (PINNED); other versions are used with a warning, and the README records the versions that made the
+files.
 """
 import argparse, glob, io, math, os, subprocess, sys, tempfile, zipfile
 
@@ -42,13 +43,16 @@ LICENCE = {
 # writing
 
 
-def clean(points, tris):
-    """Weld exactly equal points, drop triangles with a repeated corner index and unused points; float64, int64."""
+def clean(points, tris, drop_unused=True):
+    """Weld exactly equal points, drop triangles with a repeated corner index and (unless told not to) unused points;
+    float64, int64."""
     p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     t = np.asarray(tris, dtype=np.int64).reshape(-1, 3)
     p, inv = np.unique(p, axis=0, return_inverse=True)
     t = inv.reshape(-1)[t]
     t = t[(t[:, 0] != t[:, 1]) & (t[:, 1] != t[:, 2]) & (t[:, 0] != t[:, 2])]
+    if not drop_unused:
+        return p, t
     used, t = np.unique(t, return_inverse=True)
     return p[used], t.reshape(-1, 3)
 
@@ -279,6 +283,30 @@ def cad_l_bracket():
         holes += [occ.addCylinder(-1, 15, z, 8, 0, 0, 3) for z in (18, 32)]
         occ.cut(bracket, [(3, h) for h in holes])
         return m.surface_mesh(size_max=3.0)
+
+
+def cad_loft_stray_nodes():
+    """A loft through three circles (addThruSections), written as gmsh holds it: every node of the model, also those
+    no triangle uses (the curves' own nodes), as a writer of all nodes does."""
+    with Gmsh("loft") as m:
+        g = m.g
+        occ = g.model.occ
+        loops = [occ.addCurveLoop([occ.addCircle(x, 0, z, r)]) for x, z, r in [(0, 0, 1), (0, 2, 0.3), (0.5, 4, 1.2)]]
+        occ.addThruSections(loops)
+        occ.synchronize()
+        g.option.setNumber("Mesh.MeshSizeMax", 0.2)
+        g.model.mesh.generate(2)
+        tags, coords, _ = g.model.mesh.getNodes()
+        index = {int(t): i for i, t in enumerate(tags)}
+        tris = []
+        for _, tag in g.model.getEntities(2):
+            _, nodes = g.model.mesh.getElementsByType(2, tag)
+            tris.append(np.array([index[int(n)] for n in nodes]).reshape(-1, 3))
+        p, t = clean(np.asarray(coords).reshape(-1, 3), np.vstack(tris), drop_unused=False)
+        return p, orient_outward(p, t)
+
+
+cad_loft_stray_nodes.keep_unused = True
 
 
 def cad_coarse_block():
@@ -665,6 +693,9 @@ SHAPES = {
     "cad_coarse_plate": (cad_coarse_plate, GMSH_SRC, "generated", "coarse thin plate: slivers 100 long, 1 wide"),
     "cad_two_balls_default": (cad_two_balls_default, GMSH_SRC, "generated",
                               "boolean union of two balls, coarse; zeros written as -1.5e-32"),
+    "cad_loft_stray_nodes": (cad_loft_stray_nodes, GMSH_SRC, "generated",
+                             "loft through three circles, every gmsh node written: points no triangle uses, some on "
+                             "a triangle's edge"),
     "cad_chamfer_box": (cad_chamfer_box, GMSH_SRC, "generated", "chamfered edges; a zero written as -7.7e-34"),
     "cad_component8": (cad_component8, "gmsh {gmsh} OCC, STEP component8.step from the gmsh wheel",
                        LICENCE["gmsh"], "~13k-triangle machined part: facets, holes, sharp edges"),
@@ -790,7 +821,7 @@ def main():
     for name in names:
         make, source, licence, what = SHAPES[name]
         p, t = make(args.wheels) if getattr(make, "needs_wheels", False) else make()
-        p, t = clean(p, t)
+        p, t = clean(p, t, drop_unused=not getattr(make, "keep_unused", False))
         path = os.path.join(args.out, name + ".off")
         write_off(path, p, t)
         ok, msg = validate(biotet, path)

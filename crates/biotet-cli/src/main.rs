@@ -23,7 +23,8 @@ struct Cli {
     #[command(subcommand)]
     command: Command,
     /// Worker threads for the parallel stages (sliver removal's cavity searches, smoothing
-    /// sweeps, surface validation); 0 or absent: one per core. Results do not depend on it.
+    /// sweeps, surface validation); 0 or absent: one per core, and never more than the cores.
+    /// Results do not depend on it.
     #[arg(long, global = true, value_name = "N")]
     threads: Option<usize>,
     /// Memory limit (bytes, or with a unit: 512M, 8G): images, grids and compressed data larger,
@@ -110,13 +111,18 @@ fn main() -> ExitCode {
     if std::env::var_os("BIOTET_PARSE_ONLY").is_some() {
         return ExitCode::SUCCESS;
     }
-    if let Some(n) = cli.threads
-        && let Err(e) = rayon::ThreadPoolBuilder::new()
+    if let Some(asked) = cli.threads.filter(|&n| n > 0) {
+        let n = biotet::usable_threads(asked);
+        if n < asked && !std::env::args().any(|a| a == "--quiet" || a == "-q") {
+            eprintln!("note: --threads {asked}: this machine has {n} cores; using {n}");
+        }
+        if let Err(e) = rayon::ThreadPoolBuilder::new()
             .num_threads(n)
             .build_global()
-    {
-        eprintln!("error: --threads {n}: {e}");
-        return ExitCode::from(EXIT_ERROR);
+        {
+            eprintln!("error: --threads {n}: {e}");
+            return ExitCode::from(EXIT_ERROR);
+        }
     }
     biotet_io::limits::set_max_memory(
         cli.max_memory

@@ -151,8 +151,8 @@ pub fn parse_bytes(s: &str) -> Result<u64, String> {
 const BYTES_PER_TET: f64 = 160.0;
 /// Tets per node of a template mesh (5.7 on the unit cube).
 const TETS_PER_NODE: f64 = 6.0;
-/// Bytes per template voxel (one byte of state, and the classification's rows).
-const BYTES_PER_VOXEL: f64 = 2.0;
+/// Bytes per template voxel (two bytes of state and region, and the classification's rows).
+const BYTES_PER_VOXEL: f64 = 3.0;
 
 /// What meshing `surface` at `sizing` will take, estimated before any work: the template's
 /// voxels (as `template::deploy` counts them) and the nodes (the inside volume at the sizes

@@ -21,7 +21,7 @@ pub(crate) fn read_all<R: Read>(mut r: R, file: &str) -> Result<Vec<u8>> {
 /// reoriented by swapping their last two vertices. A file that MIXES orientations holds inverted
 /// elements: it is left as it is, so the checker and the quality report see them. Returns
 /// `(flipped, degenerate)`; degenerate (zero-volume) tets are kept and counted.
-pub(crate) fn orient_tets(points: &[[f64; 3]], tets: &mut [[u32; 4]]) -> (usize, usize) {
+pub fn orient_tets(points: &[[f64; 3]], tets: &mut [[u32; 4]]) -> (usize, usize) {
     let signs: Vec<Sign> = tets
         .iter()
         .map(|t| {
@@ -60,9 +60,16 @@ fn reorient<T>(signs: &[Sign], cells: &mut [T], flip: impl Fn(&mut T)) -> (usize
     (negative, degenerate)
 }
 
+/// The largest region label: the formats written (VTU's and Gmsh's Int32, numpy's int32 labels)
+/// hold labels up to 2³¹ − 1, so larger ones are refused where they are read.
+pub const MAX_LABEL: u32 = i32::MAX as u32;
+
 /// A label from an integer read from a file.
 pub(crate) fn label_of(v: i64) -> std::result::Result<u32, String> {
-    u32::try_from(v).map_err(|_| format!("region label {v} is not in 0..={}", u32::MAX))
+    u32::try_from(v)
+        .ok()
+        .filter(|&l| l <= MAX_LABEL)
+        .ok_or_else(|| format!("region label {v} is not in 0..={MAX_LABEL}"))
 }
 
 /// A region label on one side of a surface triangle: [`label_of`], with
@@ -76,12 +83,11 @@ pub(crate) fn side_label_of(v: i64) -> std::result::Result<u32, String> {
 
 /// A label from a float attribute (TetGen writes attributes as reals).
 pub(crate) fn label_of_f64(v: f64) -> std::result::Result<u32, String> {
-    if v.fract() == 0.0 && (0.0..=u32::MAX as f64).contains(&v) {
+    if v.fract() == 0.0 && (0.0..=f64::from(MAX_LABEL)).contains(&v) {
         Ok(v as u32)
     } else {
         Err(format!(
-            "region attribute {v} is not an integer in 0..={}",
-            u32::MAX
+            "region attribute {v} is not an integer in 0..={MAX_LABEL}"
         ))
     }
 }

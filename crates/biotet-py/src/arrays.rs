@@ -107,9 +107,12 @@ fn indices_from<const N: usize>(
 fn labels_from(what: &str, a: impl Iterator<Item = i64>) -> PyResult<Vec<u32>> {
     a.enumerate()
         .map(|(i, l)| {
-            u32::try_from(l).map_err(|_| {
-                PyValueError::new_err(format!("{what}[{i}] = {l} is not a label in 0..2**32"))
-            })
+            u32::try_from(l)
+                .ok()
+                .filter(|&l| l <= biotet_io::MAX_LABEL)
+                .ok_or_else(|| {
+                    PyValueError::new_err(format!("{what}[{i}] = {l} is not a label in 0..2**31"))
+                })
         })
         .collect()
 }
@@ -183,14 +186,16 @@ pub fn grid_from(
         .map_err(|e| PyValueError::new_err(format!("size_field: {e}")))
 }
 
-/// A tet mesh from points, tets and labels (adjacency rebuilt).
+/// A tet mesh from points, tets and labels (adjacency rebuilt). Tets stored the other way
+/// round throughout are turned, as the file readers do ([`biotet_io::orient_tets`]).
 pub fn mesh_from(
     points: &PyReadonlyArray2<'_, f64>,
     tets: &Ints2<'_>,
     labels: &Ints1<'_>,
 ) -> PyResult<TetMesh> {
     let pts = points_from(points)?;
-    let t = indices_from::<4>("tets", tets, pts.len())?;
+    let mut t = indices_from::<4>("tets", tets, pts.len())?;
+    biotet_io::orient_tets(&pts, &mut t);
     let n = labels.shape()[0];
     if n != t.len() {
         return Err(PyValueError::new_err(format!(

@@ -80,8 +80,8 @@ impl Failure {
     }
 }
 
-/// Run `f` without the GIL, on a pool of `threads` threads when given (else the global pool,
-/// one thread per core), catching panics. Results do not depend on the thread count.
+/// Run `f` without the GIL, on a pool of `threads` threads when given (at most one per core;
+/// else the global pool, one thread per core), catching panics. Results do not depend on the thread count.
 pub fn guarded<T: Send>(
     py: Python<'_>,
     threads: Option<usize>,
@@ -89,7 +89,7 @@ pub fn guarded<T: Send>(
 ) -> PyResult<T> {
     let out = py.detach(move || {
         let run = move || catch_unwind(AssertUnwindSafe(f));
-        match threads.filter(|&n| n > 0) {
+        match threads.filter(|&n| n > 0).map(biotet::usable_threads) {
             Some(n) => match rayon::ThreadPoolBuilder::new().num_threads(n).build() {
                 Ok(pool) => pool.install(run),
                 Err(e) => Ok(Err(Failure::new(

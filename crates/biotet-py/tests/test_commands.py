@@ -79,3 +79,16 @@ def test_bad_stage_options():
         biotet.smooth(m, feature_angle=200.0)
     with pytest.raises(ValueError, match="integers"):
         biotet.quality(biotet.TetMesh(m.points, m.tets, m.labels.astype(float)))
+
+
+def test_tets_stored_the_other_way_round_are_turned_as_the_readers_do():
+    # Another tool's convention: every tet negative. The file readers turn them all; arrays
+    # handed to check, improve and smooth are turned the same way (before, improve and smooth
+    # returned them unchanged and check called the result invalid).
+    s = biotet.read_surface(SHAPES / "cad_as1_nut_default.off")
+    m = biotet.mesh(s.points, s.triangles)
+    other = biotet.TetMesh(m.points, m.tets[:, [1, 0, 2, 3]], m.labels)
+    assert biotet.check(other, s)["valid"]
+    for out in (biotet.improve(other), biotet.smooth(other)):
+        assert biotet.check(out, s)["valid"]
+        assert out.n_tets == m.n_tets

@@ -232,6 +232,12 @@ def test_bad_label_volumes_and_options_raise_the_cli_messages(cli, tmp_path):
         biotet.mesh_image(bad)
     with pytest.raises(ValueError, match=r"voxel \(0, 0, 0\) holds 0.5"):
         biotet.mesh_image(np.full((2, 2, 2), 0.5))
+    # Labels the written formats cannot hold (Int32): refused before meshing, not wrapped to
+    # negative numbers or refused by the writer after it.
+    big = lab.astype(np.uint32)
+    big[big == big.max()] = 3_000_000_000
+    with pytest.raises(ValueError, match=r"holds 3000000000, not a label \(an integer in 0..2\*\*31\)"):
+        biotet.mesh_image(big)
     with pytest.raises(ValueError, match="3-D"):
         biotet.mesh_image(lab[0])
     with pytest.raises(ValueError, match="not a finite invertible"):

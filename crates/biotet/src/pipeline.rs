@@ -97,6 +97,10 @@ pub struct MeshReport {
     pub template: TemplateStats,
     /// Surface points (all become mesh points).
     pub n_surface_points: usize,
+    /// Points of the input surface that no triangle uses, left out (a file's stray nodes: one
+    /// lying on a triangle would block its recovery, one inside would be a node nobody asked
+    /// for).
+    pub n_unused_points: usize,
     /// Interior nodes deployed.
     pub n_interior_nodes: usize,
     /// Finite tets of the Delaunay tetrahedralization (the convex hull).
@@ -142,7 +146,8 @@ pub enum PipelineError {
 
 /// Mesh the volume bounded by `surface` (validated: closed, consistently oriented, labelled).
 ///
-/// The output's first points are the surface's points (same indices), then the interior nodes;
+/// The output's first points are the surface's points (same order; points no triangle uses are
+/// left out), then the interior nodes;
 /// tets carry the label of the region containing them. `progress` hears each stage's name as it
 /// starts. The sizing is used by node deployment only: passed by value (rather than as
 /// `&Sizing`), it is freed once the nodes are placed, before the later stages' peaks.
@@ -153,7 +158,19 @@ pub fn mesh_surface<S: Borrow<Sizing>>(
     progress: &mut dyn FnMut(&str),
 ) -> Result<(TetMesh, MeshReport), PipelineError> {
     let start = Instant::now();
-    let mut report = MeshReport::default();
+    let mut report = MeshReport {
+        n_unused_points: surface.n_unused_points(),
+        ..MeshReport::default()
+    };
+    let used;
+    let surface = if report.n_unused_points > 0 {
+        let mut s = surface.clone();
+        s.drop_unused_points();
+        used = s;
+        &used
+    } else {
+        surface
+    };
 
     progress("deploying nodes");
     let clock = Instant::now();

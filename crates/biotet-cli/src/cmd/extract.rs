@@ -50,7 +50,14 @@ impl ImageArgs {
                 let to = to
                     .trim()
                     .parse::<u32>()
-                    .with_context(|| format!("--merge {m}: bad target"))?;
+                    .ok()
+                    .filter(|&n| n <= biotet_io::MAX_LABEL)
+                    .with_context(|| {
+                        format!(
+                            "--merge {m}: the target is a whole number from 0 to {}",
+                            biotet_io::MAX_LABEL
+                        )
+                    })?;
                 Ok((from, to))
             })
             .collect::<Result<Vec<_>>>()?;

@@ -96,8 +96,21 @@ pub fn parse_labels(items: &[String], files: &[PathBuf]) -> Result<Vec<Option<Ve
             .iter()
             .position(|p| p.as_os_str() == f || p.file_name().is_some_and(|n| n == f))
             .with_context(|| format!("--label {item}: {f} is not one of the input surfaces"))?;
-        let v: Result<Vec<u32>, _> = l.split(',').map(|x| x.trim().parse::<u32>()).collect();
-        out[i] = Some(v.with_context(|| format!("--label {item}: bad label"))?);
+        let v: Option<Vec<u32>> = l
+            .split(',')
+            .map(|x| {
+                x.trim()
+                    .parse::<u32>()
+                    .ok()
+                    .filter(|&n| n <= biotet_io::MAX_LABEL)
+            })
+            .collect();
+        out[i] = Some(v.with_context(|| {
+            format!(
+                "--label {item}: labels are whole numbers from 0 to {}",
+                biotet_io::MAX_LABEL
+            )
+        })?);
     }
     Ok(out)
 }

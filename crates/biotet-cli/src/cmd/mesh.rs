@@ -99,7 +99,7 @@ pub struct Args {
     /// Shape of the buffer zone around each node (Euclidean measured better; see docs/commands.md).
     #[arg(long, value_enum, default_value = "euclidean")]
     zone: ZoneArg,
-    /// Largest template size in voxels (one byte each).
+    /// Largest template size in voxels (two bytes each).
     #[arg(long, value_name = "N", default_value_t = 1 << 31)]
     max_voxels: usize,
     /// Skip boundary recovery (LAST RESORT), and polishing, which needs it; missing input
@@ -454,6 +454,12 @@ pub fn run(a: Args) -> Result<ExitCode> {
             report.n_surface_points,
             report.n_interior_nodes,
         );
+        if report.n_unused_points > 0 {
+            text += &format!(
+                "{} input points used by no triangle left out\n",
+                report.n_unused_points
+            );
+        }
         if let Some(r) = &surface_report {
             text += &super::surface::report_text(r);
             text.push('\n');

@@ -39,11 +39,17 @@ pub fn run(a: Args) -> Result<ExitCode> {
         )?;
         drop(stage);
         if !a.common.quiet && !a.common.json {
+            let unused = mesh.points.len() - report.n_used_points;
             crate::emit(&format!(
-                "{}: valid: {} points, {} triangles\n{report}",
+                "{}: valid: {} points, {} triangles{}\n{report}",
                 path.display(),
                 mesh.points.len(),
-                mesh.triangles.len()
+                mesh.triangles.len(),
+                if unused > 0 {
+                    format!(" ({unused} points used by no triangle: left out when meshing)")
+                } else {
+                    String::new()
+                }
             ));
         }
         out.push(json!({"file": path, "report": report}));

@@ -19,6 +19,7 @@ use std::path::Path;
 
 use biotet::image::LabelImage;
 
+use crate::common::MAX_LABEL;
 use crate::error::{Error, Result};
 
 pub mod metaimage;
@@ -131,31 +132,27 @@ pub(crate) fn voxel_count(dims: [usize; 3], file: &str) -> Result<usize> {
     Ok(n)
 }
 
-/// A label from a float value: finite, integral, in `0..=u32::MAX`.
+/// A label from a float value: finite, integral, in `0..=MAX_LABEL`.
 pub(crate) fn float_label(x: f64, at: usize, file: &str) -> Result<u32> {
-    if x.is_finite() && x.fract() == 0.0 && (0.0..=u32::MAX as f64).contains(&x) {
+    if x.is_finite() && x.fract() == 0.0 && (0.0..=f64::from(MAX_LABEL)).contains(&x) {
         Ok(x as u32)
     } else {
-        Err(Error::format(
-            file,
-            format!(
-                "voxel {at} holds {x}: labels must be whole numbers from 0 to {}",
-                u32::MAX
-            ),
-        ))
+        Err(not_a_label(x, at, file))
     }
 }
 
 fn int_label(x: i128, at: usize, file: &str) -> Result<u32> {
-    u32::try_from(x).map_err(|_| {
-        Error::format(
-            file,
-            format!(
-                "voxel {at} holds {x}: labels must be whole numbers from 0 to {}",
-                u32::MAX
-            ),
-        )
-    })
+    u32::try_from(x)
+        .ok()
+        .filter(|&l| l <= MAX_LABEL)
+        .ok_or_else(|| not_a_label(x, at, file))
+}
+
+fn not_a_label(x: impl std::fmt::Display, at: usize, file: &str) -> Error {
+    Error::format(
+        file,
+        format!("voxel {at} holds {x}: labels must be whole numbers from 0 to {MAX_LABEL}"),
+    )
 }
 
 /// Decode `n` voxels of type `ty` from `bytes` (at least `n·size` long) to labels.
@@ -190,7 +187,11 @@ pub(crate) fn decode(
             Scalar::I8 => int_label(b[0] as i8 as i128, at, file)?,
             Scalar::U16 => u16::from_le_bytes([b[0], b[1]]) as u32,
             Scalar::I16 => int_label(i16::from_le_bytes([b[0], b[1]]) as i128, at, file)?,
-            Scalar::U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+            Scalar::U32 => int_label(
+                u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as i128,
+                at,
+                file,
+            )?,
             Scalar::I32 => int_label(
                 i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as i128,
                 at,

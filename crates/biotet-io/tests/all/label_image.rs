@@ -129,6 +129,26 @@ fn parse(f: &str, bytes: &[u8]) -> biotet_io::Result<LabelImage> {
     }
 }
 
+/// A label the written formats cannot hold (VTU's Int32): refused where it is read, naming the
+/// voxel, not after meshing by the writer.
+#[test]
+fn labels_past_int32_are_refused() {
+    let mut bytes =
+        b"NRRD0004\ntype: uint32\ndimension: 3\nsizes: 2 1 1\nencoding: raw\nendian: little\n\n"
+            .to_vec();
+    for v in [1u32, 3_000_000_000] {
+        bytes.extend_from_slice(&v.to_le_bytes());
+    }
+    let err = parse("big.nrrd", &bytes).unwrap_err().to_string();
+    assert!(
+        err.contains("voxel 1 holds 3000000000") && err.contains("2147483647"),
+        "{err}"
+    );
+    let n = bytes.len();
+    bytes[n - 4..].copy_from_slice(&2_147_483_647u32.to_le_bytes());
+    assert_eq!(parse("big.nrrd", &bytes).unwrap().labels[1], 2_147_483_647);
+}
+
 /// Random bytes, every truncation, and random byte flips of every fixture: an error or an
 /// image, never a panic (a flipped byte may still give a valid image).
 #[test]

@@ -329,7 +329,7 @@ fn messages_name_file_place_and_reason() {
     let e = err(medit::parse_tet(b"MeshVersionFormatted 2\nDimension 3\nVertices\n4\n0 0 0 0\n1 0 0 0\n0 1 0 0\n0 0 1 0\nTetrahedra\n1\n1 2 3 4 -1\nEnd\n", "m.mesh"));
     assert_eq!(
         e,
-        "m.mesh: line 11: region label -1 is not in 0..=4294967295"
+        "m.mesh: line 11: region label -1 is not in 0..=2147483647"
     );
     // Gmsh.
     let g = b"$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n1\n1 0 0 0\n$EndNodes\n$Elements\n1\n1 4 0 1 2 3 99\n$EndElements\n";

@@ -354,7 +354,7 @@ def _image_options(keep_labels: Iterable[int] | None, merge: Mapping[int, int] |
     )
 
 
-_LABEL_MAX = 2**32 - 1
+_LABEL_MAX = 2**31 - 1
 
 
 def _label_volume(labels: Any) -> np.ndarray:
@@ -364,7 +364,7 @@ def _label_volume(labels: Any) -> np.ndarray:
     a = np.asarray(labels)
     if a.ndim != 3:
         raise ValueError(f"labels must be a 3-D array (i, j, k), not of shape {a.shape}")
-    if a.dtype == np.bool_ or a.dtype == np.uint32:
+    if a.dtype == np.bool_:
         return np.asarray(a, dtype=np.uint32)
     if np.issubdtype(a.dtype, np.integer):
         bad = (a < 0) | (a > _LABEL_MAX)
@@ -377,7 +377,7 @@ def _label_volume(labels: Any) -> np.ndarray:
         first = int(np.flatnonzero(bad.ravel(order="F"))[0])
         ijk = tuple(int(x) for x in np.unravel_index(first, a.shape, order="F"))
         raise ValueError(
-            f"labels: voxel {ijk} holds {a[ijk]}, not a label (an integer in 0..2**32)"
+            f"labels: voxel {ijk} holds {a[ijk]}, not a label (an integer in 0..2**31)"
         )
     return np.asarray(a, dtype=np.uint32)
 
@@ -427,7 +427,7 @@ def mesh(
     ``surface_tolerance=D`` first remeshes the surface within a two-sided Hausdorff distance D
     (``--surface-tolerance D``; reported in ``report["surface"]``): fewer slivers, the surface
     no longer kept exactly; ``surface_feature_angle``, ``surface_rounds`` and ``adaptive_size``
-    are that stage's ``--feature-angle``, ``--surface-rounds`` and ``--adaptive-size``. ``threads``: worker threads (default one per core; the result does
+    are that stage's ``--feature-angle``, ``--surface-rounds`` and ``--adaptive-size``. ``threads``: worker threads (default, and at most, one per core; the result does
     not depend on it). ``progress``: called with each stage's name (default: the ``biotet``
     logger at level INFO).
 
@@ -507,7 +507,7 @@ def mesh_image(
     ``surface_tolerance=D`` first remeshes the surface within a two-sided Hausdorff distance D
     (``--surface-tolerance D``; reported in ``report["surface"]``): fewer slivers, the surface
     no longer kept exactly; ``surface_feature_angle``, ``surface_rounds`` and ``adaptive_size``
-    are that stage's ``--feature-angle``, ``--surface-rounds`` and ``--adaptive-size``. ``threads``: worker threads (default one per core; the result does
+    are that stage's ``--feature-angle``, ``--surface-rounds`` and ``--adaptive-size``. ``threads``: worker threads (default, and at most, one per core; the result does
     not depend on it). ``progress``: called with each stage's name (default: the ``biotet``
     logger at level INFO). A bare array as ``size_field`` is taken on the image's own grid.
 
@@ -578,7 +578,7 @@ def mesh_file(
     ``surface_tolerance=D`` first remeshes the surface within a two-sided Hausdorff distance D
     (``--surface-tolerance D``; reported in ``report["surface"]``): fewer slivers, the surface
     no longer kept exactly; ``surface_feature_angle``, ``surface_rounds`` and ``adaptive_size``
-    are that stage's ``--feature-angle``, ``--surface-rounds`` and ``--adaptive-size``. ``threads``: worker threads (default one per core; the result does
+    are that stage's ``--feature-angle``, ``--surface-rounds`` and ``--adaptive-size``. ``threads``: worker threads (default, and at most, one per core; the result does
     not depend on it). ``progress``: called with each stage's name (default: the ``biotet``
     logger at level INFO).
 

@@ -122,6 +122,9 @@ pub fn labelled_surface(
     let labels = apply(&mut img, opts)?;
     let seconds_labels = clock.elapsed().as_secs_f64();
     let voxel_to_world = img.voxel_to_world;
+    // The world voxel's volume: the frame's is the product of the spacings, which a sheared map
+    // does not keep.
+    let vv = img.voxel_volume();
     let frame_to_world = img.to_frame();
     let clock = Instant::now();
     progress("extracting the surface");
@@ -137,7 +140,6 @@ pub fn labelled_surface(
     };
     validate_surface(&mut surface, &vopts).map_err(ImageSurfaceError::Surface)?;
     let seconds_validate = clock.elapsed().as_secs_f64();
-    let vv = img.voxel_volume();
     let comps = Components::of(&img);
     let count_of = |v: &[(u32, usize)], l: u32| v.iter().find(|c| c.0 == l).map_or(0, |c| c.1);
     let mut after: Vec<(u32, usize)> = Vec::new();

@@ -133,6 +133,39 @@ impl SurfaceMesh {
         r
     }
 
+    /// The number of points no triangle uses.
+    pub fn n_unused_points(&self) -> usize {
+        let mut used = vec![false; self.points.len()];
+        for &v in self.triangles.iter().flatten() {
+            if let Some(u) = used.get_mut(v as usize) {
+                *u = true;
+            }
+        }
+        used.iter().filter(|&&u| !u).count()
+    }
+
+    /// Drop the points no triangle uses, keeping the others' order; returns how many went.
+    pub fn drop_unused_points(&mut self) -> usize {
+        let mut new_index = vec![u32::MAX; self.points.len()];
+        for &v in self.triangles.iter().flatten() {
+            new_index[v as usize] = 0;
+        }
+        let mut k = 0;
+        for (i, x) in new_index.iter_mut().enumerate() {
+            if *x != u32::MAX {
+                *x = k as u32;
+                self.points[k] = self.points[i];
+                k += 1;
+            }
+        }
+        let dropped = self.points.len() - k;
+        self.points.truncate(k);
+        for t in &mut self.triangles {
+            *t = t.map(|v| new_index[v as usize]);
+        }
+        dropped
+    }
+
     /// Append another surface (points are not merged).
     pub fn append(&mut self, other: &SurfaceMesh) {
         let off = self.points.len() as u32;

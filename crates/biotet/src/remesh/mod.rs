@@ -50,11 +50,24 @@ pub enum Zone {
     },
 }
 
+impl std::fmt::Display for Zone {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let p = |x: &P3| format!("({}, {}, {})", x[0], x[1], x[2]);
+        match self {
+            Zone::Region(r) => write!(f, "region {r}"),
+            Zone::Box { lo, hi } => write!(f, "the box from {} to {}", p(lo), p(hi)),
+            Zone::Sphere { centre, radius } => {
+                write!(f, "the ball of radius {radius} around {}", p(centre))
+            }
+        }
+    }
+}
+
 /// Why remeshing could not run.
 #[derive(Debug, thiserror::Error)]
 pub enum RemeshError {
     /// No tet is in the zone.
-    #[error("no tet in the zone ({0})")]
+    #[error("no tet in {0}")]
     Empty(String),
     /// The sizing could not be built on a cavity's shell.
     #[error("region {region}: sizing")]
@@ -215,7 +228,7 @@ pub fn remesh(
         .map(|t| zone::meets(zone, mesh.labels[t], &mesh.corners(t)))
         .collect();
     if !carved.contains(&true) {
-        return Err(RemeshError::Empty(format!("{zone:?}")));
+        return Err(RemeshError::Empty(zone.to_string()));
     }
     let (cavities, grown) = cavity::cavities(mesh, &mut carved)?;
     cavity::replace(

@@ -36,7 +36,7 @@ use crate::geom::vec3::volume6;
 use crate::mesh::surface::SurfaceMesh;
 use crate::mesh::validate::{self, ValidateOptions, validate_surface};
 use bvh::PatchIndex;
-use rustc_hash::FxHashSet;
+use rustc_hash::{FxHashMap, FxHashSet};
 
 /// What [`improve`] does.
 #[derive(Debug, Clone, PartialEq)]
@@ -258,6 +258,25 @@ fn angle_stats(s: &SurfaceMesh, target: f64) -> (f64, f64, usize) {
     (lo, hi, n)
 }
 
+/// Turn every triangle whose side labels are the reverse of those of the first triangle between
+/// the same two regions (the same triangle seen from the other side); returns how many turned.
+/// A label image's voxel faces are oriented by their axis, so half of one sheet has `[1, 0]` and
+/// half `[0, 1]`: the remesher projects a triangle only onto input of its own side labels, and
+/// would keep every edge where they change as an interface rim.
+fn orient_sheets(s: &mut SurfaceMesh) -> usize {
+    let mut first: FxHashMap<[u32; 2], [u32; 2]> = FxHashMap::default();
+    let mut turned = 0;
+    for t in 0..s.triangles.len() {
+        let [a, b] = s.sides[t];
+        let want = *first.entry([a.min(b), a.max(b)]).or_insert([a, b]);
+        if want != [a, b] {
+            s.flip_triangle(t);
+            turned += 1;
+        }
+    }
+    turned
+}
+
 /// Remesh `surface` within `opts.tolerance` of itself (see the [module documentation](self)).
 ///
 /// The input must be a valid surface ([`validate_surface`]). The output is valid, has the same
@@ -295,6 +314,8 @@ pub fn improve_with_progress(
         },
     )
     .map_err(SurfaceError::Input)?;
+    orient_sheets(&mut input);
+    let surface = &input;
     let l = match opts.edge_length {
         Some(h) if h.is_finite() && h > 0.0 => h,
         Some(h) => {

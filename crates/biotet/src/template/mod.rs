@@ -7,7 +7,7 @@
 //! their nodes' zones are sealed with scaled prisms (eq. 2.7, [`seal`]); then a front advancing
 //! inward from that boundary buffer turns each unprocessed inside voxel it reaches into an
 //! interior node with its own zone (eq. 2.8, [`sweep`]). Node coordinates follow eq. 2.9. The
-//! template is one byte per voxel ([`voxels`]) and is freed before the nodes are returned.
+//! template is two bytes per voxel ([`voxels`]) and is freed before the nodes are returned.
 //!
 //! Interior nodes are strictly inside the surface (exactly decided) and never on it.
 
@@ -35,7 +35,7 @@ pub struct DeployOptions {
     pub zone: Zone,
     /// Voxels of margin around the bounding box on each side (eq. 2.2 uses one each side, "+2").
     pub margin: usize,
-    /// Refuse templates with more voxels than this (one byte each).
+    /// Refuse templates with more voxels than this (two bytes each).
     pub max_voxels: usize,
 }
 

@@ -1,23 +1,27 @@
-//! The voxel template: one byte per voxel (dissertation section 2.3.1, Table 2.1).
+//! The voxel template: one [`Cell`] per voxel (dissertation section 2.3.1, Table 2.1).
 //!
 //! Bits 0–1 hold the state (unprocessed, buffer, surface node, interior node), bit 2 marks a
-//! voxel already queued by the inward sweep, bits 3–7 the region containing the voxel centre
-//! (0 = outside), so a template of `n` voxels takes exactly `n` bytes.
+//! voxel already queued by the inward sweep, bits 3–15 the region containing the voxel centre
+//! (0 = outside). The seed's byte held 31 regions; a FreeSurfer parcellation has over a hundred
+//! labels and a scan of loose parts as many shells, so a voxel takes two bytes.
+
+/// One voxel's bits.
+pub type Cell = u16;
 
 /// State: not yet claimed.
-pub const UNPROCESSED: u8 = 0;
+pub const UNPROCESSED: Cell = 0;
 /// State: inside some node's buffer zone; no node may go here.
-pub const BUFFER: u8 = 1;
+pub const BUFFER: Cell = 1;
 /// State: the nearest voxel of a surface node.
-pub const SURFACE_NODE: u8 = 2;
+pub const SURFACE_NODE: Cell = 2;
 /// State: an interior node.
-pub const INTERIOR_NODE: u8 = 3;
-const STATE: u8 = 0b11;
+pub const INTERIOR_NODE: Cell = 3;
+const STATE: Cell = 0b11;
 /// Flag: queued by the sweep.
-pub const QUEUED: u8 = 0b100;
-const REGION_SHIFT: u8 = 3;
+pub const QUEUED: Cell = 0b100;
+const REGION_SHIFT: u32 = 3;
 /// Largest region label the template can hold.
-pub const MAX_REGION: u32 = 31;
+pub const MAX_REGION: u32 = (Cell::MAX >> REGION_SHIFT) as u32;
 
 /// Shape of a buffer zone of radius `r` voxels around a node voxel.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -37,8 +41,8 @@ pub struct Template {
     pub origin: [f64; 3],
     /// Spacing (eq. 2.1).
     pub dx: f64,
-    /// One byte per voxel, x fastest.
-    pub cells: Vec<u8>,
+    /// One cell per voxel, x fastest.
+    pub cells: Vec<Cell>,
     /// Per row `(j, k)` (index `j + n[1]·k`), its first and last inside voxel (first above last:
     /// none), kept by [`Template::set_region_span`]: sealing scans only that part of a row, since
     /// only inside voxels become nodes.
@@ -100,13 +104,13 @@ impl Template {
 
     /// State bits of a voxel.
     #[inline]
-    pub fn state(&self, idx: usize) -> u8 {
+    pub fn state(&self, idx: usize) -> Cell {
         self.cells[idx] & STATE
     }
 
     /// Set the state bits, keeping the others.
     #[inline]
-    pub fn set_state(&mut self, idx: usize, s: u8) {
+    pub fn set_state(&mut self, idx: usize, s: Cell) {
         self.cells[idx] = (self.cells[idx] & !STATE) | s;
     }
 
@@ -119,7 +123,7 @@ impl Template {
     /// Set the region of voxels `lo..hi` of one row (they must still be region 0).
     #[inline]
     pub fn set_region_span(&mut self, row_start: usize, lo: usize, hi: usize, region: u32) {
-        let bits = (region as u8) << REGION_SHIFT;
+        let bits = (region as Cell) << REGION_SHIFT;
         for c in &mut self.cells[row_start + lo..row_start + hi] {
             *c |= bits;
         }
@@ -172,7 +176,7 @@ impl Template {
 
     /// Bytes held by the template.
     pub fn bytes(&self) -> usize {
-        self.cells.len()
+        std::mem::size_of_val(self.cells.as_slice())
     }
 }
 

@@ -124,6 +124,20 @@ fn three_labels_meet_at_a_line() {
 }
 
 #[test]
+fn forty_eight_labels_each_keep_their_region() {
+    // 48 labels in 2-voxel blocks, each touching its neighbours (interfaces, triple lines,
+    // corners where eight meet): more regions than the seed's one-byte template held (31).
+    let img = image([14, 10, 5], |i, j, k| {
+        if i == 0 || j == 0 || i == 13 || j == 9 || k == 4 {
+            return 0;
+        }
+        (1 + (i - 1) / 2 + 6 * ((j - 1) / 2) + 24 * (k / 2)) as u32
+    });
+    assert_eq!(img.counts().len(), 49);
+    extract_and_mesh(img, 1.0);
+}
+
+#[test]
 fn one_voxel_thick_layer() {
     // A slab of label 2, one voxel thick, between two blocks of 1 and 3; and a one-voxel shell
     // of 4 around everything.
@@ -285,4 +299,39 @@ fn random_label_noise_always_validates() {
             assert!((r.volume - n as f64 * img.voxel_volume()).abs() < 1e-9 * r.volume);
         }
     }
+}
+
+/// A sheared voxel-to-world map (x += 0.5 y): the regions' voxel volumes are world volumes
+/// (the map's determinant, 1 here), not the product of the axes' lengths (1.118), which the
+/// image's axis-aligned frame has.
+#[test]
+fn a_sheared_image_reports_world_voxel_volumes() {
+    let labels = (0..5 * 5 * 5)
+        .map(|i| {
+            let (x, y, z) = (i % 5, (i / 5) % 5, i / 25);
+            u32::from((1..4).contains(&x) && (1..4).contains(&y) && (1..4).contains(&z))
+        })
+        .collect();
+    let m = [
+        [1.0, 0.5, 0.0, 0.0],
+        [0.0, 1.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0, 0.0],
+        [0.0, 0.0, 0.0, 1.0],
+    ];
+    let img = LabelImage::new([5, 5, 5], m, labels).unwrap();
+    let (_, summary) = biotet::image::surface::labelled_surface(
+        img,
+        &LabelOptions::default(),
+        "sheared",
+        &mut |_| {},
+    )
+    .unwrap();
+    assert!(summary.frame_to_world.is_some());
+    assert_eq!(summary.regions.len(), 1);
+    assert!(
+        (summary.regions[0].voxel_volume - 27.0).abs() < 1e-12,
+        "{:?}",
+        summary.regions
+    );
+    assert!((summary.voxel_volume - 1.0).abs() < 1e-15);
 }

@@ -897,3 +897,24 @@ fn an_unrecovered_cube_keeps_its_inside() {
     assert!(c.valid, "{c}");
     assert!((mesh_volume(&m) - 1.0).abs() < 1e-12, "{}", mesh_volume(&m));
 }
+
+/// Points no triangle uses (a file's stray nodes) are left out of the mesh: one on a face and
+/// one on an edge of the cube used to block those triangles' recovery, and one inside became a
+/// node nobody asked for.
+#[test]
+fn points_no_triangle_uses_are_left_out() {
+    let mut s = crate::common::cube_surface([0.0; 3], 1.0);
+    let stray = [
+        [1.0 / 3.0, 1.0 / 3.0, 0.0],
+        [0.5, 0.0, 0.0],
+        [0.3, 0.6, 0.45],
+    ];
+    s.points.extend_from_slice(&stray);
+    let (m, report) = mesh_pipeline(&s, biotet::pipeline::PipelineOptions::default());
+    assert_eq!(report.n_unused_points, 3);
+    assert_eq!(report.missing_triangles, 0);
+    assert!(!m.points.iter().any(|p| stray.contains(p)));
+    let c = check(&m, Some(&s));
+    assert!(c.valid, "{c}");
+    assert!((mesh_volume(&m) - 1.0).abs() < 1e-12);
+}

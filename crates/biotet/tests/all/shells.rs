@@ -42,6 +42,38 @@ fn nested_cubes_make_two_regions_innermost_first() {
 }
 
 #[test]
+fn forty_loose_cubes_are_forty_regions() {
+    // A scan of loose parts: each shell its own region, more than the seed's one-byte template
+    // held (31 labels).
+    let parts: Vec<Part> = (0..40)
+        .map(|i| {
+            part(
+                cube_surface([3.0 * (i % 8) as f64, 3.0 * (i / 8) as f64, 0.0], 1.0),
+                None,
+            )
+        })
+        .collect();
+    let (mut s, shells) = assemble(parts).unwrap();
+    assert_eq!(shells.len(), 40);
+    validate_surface(&mut s, &ValidateOptions::default()).unwrap();
+    let sizing = Sizing::uniform(0.5).unwrap();
+    let (mesh, _) = mesh_surface(&s, &sizing, &PipelineOptions::default(), &mut |_| {}).unwrap();
+    let c = biotet::check::check(&mesh, Some(&s));
+    assert!(c.valid, "{c}");
+    let mut labels = mesh.labels.clone();
+    labels.sort_unstable();
+    labels.dedup();
+    assert_eq!(labels, (1..=40).collect::<Vec<u32>>());
+    for l in 1..=40 {
+        let v: f64 = (0..mesh.tets.len())
+            .filter(|&t| mesh.labels[t] == l)
+            .map(|t| volume(&mesh.corners(t)))
+            .sum();
+        assert!((v - 1.0).abs() < 1e-9, "region {l}: volume {v}");
+    }
+}
+
+#[test]
 fn explicit_labels_and_cavities() {
     let outer = cube_surface([0.0; 3], 4.0);
     let inner = cube_surface([1.0; 3], 2.0);

@@ -215,7 +215,7 @@ fn sphere_and_cube_spacing_and_clearance() {
 }
 
 #[test]
-fn deployment_is_deterministic_and_template_is_one_byte_per_voxel() {
+fn deployment_is_deterministic_and_template_is_two_bytes_per_voxel() {
     let s = SurfaceMesh::icosphere(10.0, 2);
     let sizing = Sizing::uniform(1.5).unwrap();
     let a = deploy(&s, &sizing, &DeployOptions::default()).unwrap();
@@ -223,7 +223,7 @@ fn deployment_is_deterministic_and_template_is_one_byte_per_voxel() {
     assert_eq!(a.points, b.points);
     let st = &a.stats;
     assert_eq!(st.voxels, st.dims[0] * st.dims[1] * st.dims[2]);
-    assert_eq!(st.bytes, st.voxels);
+    assert_eq!(st.bytes, 2 * st.voxels);
     assert!((st.dx - 0.75).abs() < 1e-15);
     // Too fine a template is refused with a clear error, not attempted.
     let tiny = Sizing::uniform(1e-4).unwrap();
