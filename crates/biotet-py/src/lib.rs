@@ -256,6 +256,7 @@ fn mesh_with(
                 feature_angle_deg: o.surface_feature_angle,
                 rounds: o.surface_rounds,
                 adaptive: o.adaptive_size,
+                orient_sheets: image.as_ref().is_none_or(|i| i.orient_sheets()),
                 ..Default::default()
             };
             let (s, r) = biotet::surface::improve(&surface, &so)

@@ -239,8 +239,10 @@ pub fn run(a: Args) -> Result<ExitCode> {
         None => (surface, None),
         Some(d) => {
             stage.set("improving the surface");
-            let (s, r) = super::surface::stage(&surface, d, a.size, &a.surface_stage, &stage)
-                .with_context(|| name.clone())?;
+            let orient = image.as_ref().is_none_or(|i| i.orient_sheets());
+            let (s, r) =
+                super::surface::stage(&surface, d, a.size, &a.surface_stage, orient, &stage)
+                    .with_context(|| name.clone())?;
             (s, Some(r))
         }
     };

@@ -123,6 +123,7 @@ pub fn stage(
     tolerance: f64,
     edge_length: Option<f64>,
     s: &StageArgs,
+    orient_sheets: bool,
     progress: &Stage,
 ) -> Result<(SurfaceMesh, SurfaceReport)> {
     let opts = SurfaceOptions {
@@ -131,6 +132,7 @@ pub fn stage(
         feature_angle_deg: s.feature_angle,
         rounds: s.surface_rounds,
         adaptive: s.adaptive_size,
+        orient_sheets,
         ..Default::default()
     };
     Ok(improve_with_progress(surface, &opts, &|step| {
@@ -196,8 +198,15 @@ fn run_improve(a: ImproveArgs) -> Result<ExitCode> {
     let (surface, _, name) =
         super::input::labelled_surface(&a.surfaces, &a.label, a.common, &stage_)?;
     stage_.set("improving the surface");
-    let (out, report) = stage(&surface, a.tolerance, a.edge_length, &a.stage, &stage_)
-        .with_context(|| name.clone())?;
+    let (out, report) = stage(
+        &surface,
+        a.tolerance,
+        a.edge_length,
+        &a.stage,
+        true,
+        &stage_,
+    )
+    .with_context(|| name.clone())?;
     if let Some(path) = &a.output {
         stage_.set(format!("writing {}", path.display()));
         biotet_io::write_surface(path, &out)?;

@@ -61,6 +61,10 @@ pub struct SurfaceOptions {
     /// length), down to a 32nd of that on the triangles whose bound it does not prove within
     /// the tolerance (a maximum 0.487 D from D needs a step under D/40 to prove it).
     pub sample_spacing: Option<f64>,
+    /// Turn each sheet one way first (`orient_sheets`), so edges where a sheet's triangles change
+    /// orientation are not kept as interface rims. Default `true`; a label image of cubic voxels
+    /// runs without it ([`crate::image::surface::ImageSummary::orient_sheets`]).
+    pub orient_sheets: bool,
 }
 
 /// Remeshing rounds by default: on the marching-cubes test surfaces a fifth and sixth round
@@ -78,6 +82,7 @@ impl Default for SurfaceOptions {
             target_angle_deg: 30.0,
             sample_spacing: None,
             adaptive: false,
+            orient_sheets: true,
         }
     }
 }
@@ -314,7 +319,9 @@ pub fn improve_with_progress(
         },
     )
     .map_err(SurfaceError::Input)?;
-    orient_sheets(&mut input);
+    if opts.orient_sheets {
+        orient_sheets(&mut input);
+    }
     let surface = &input;
     let l = match opts.edge_length {
         Some(h) if h.is_finite() && h > 0.0 => h,
