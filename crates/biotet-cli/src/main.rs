@@ -23,8 +23,8 @@ struct Cli {
     #[command(subcommand)]
     command: Command,
     /// Worker threads for the parallel stages (sliver removal's cavity searches, smoothing
-    /// sweeps, surface validation); 0 or absent: one per core, and never more than the cores.
-    /// Results do not depend on it.
+    /// sweeps, surface validation); 0 or absent: one per core; at most four a core. Results do
+    /// not depend on it.
     #[arg(long, global = true, value_name = "N")]
     threads: Option<usize>,
     /// Memory limit (bytes, or with a unit: 512M, 8G): images, grids and compressed data larger,
@@ -114,7 +114,7 @@ fn main() -> ExitCode {
     if let Some(asked) = cli.threads.filter(|&n| n > 0) {
         let n = biotet::usable_threads(asked);
         if n < asked && !std::env::args().any(|a| a == "--quiet" || a == "-q") {
-            eprintln!("note: --threads {asked}: this machine has {n} cores; using {n}");
+            eprintln!("note: --threads {asked}: using {n}, four for each of this machine's cores");
         }
         if let Err(e) = rayon::ThreadPoolBuilder::new()
             .num_threads(n)

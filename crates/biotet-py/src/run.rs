@@ -80,7 +80,7 @@ impl Failure {
     }
 }
 
-/// Run `f` without the GIL, on a pool of `threads` threads when given (at most one per core;
+/// Run `f` without the GIL, on a pool of `threads` threads when given (at most four a core;
 /// else the global pool, one thread per core), catching panics. Results do not depend on the thread count.
 pub fn guarded<T: Send>(
     py: Python<'_>,

@@ -427,7 +427,7 @@ def mesh(
     ``surface_tolerance=D`` first remeshes the surface within a two-sided Hausdorff distance D
     (``--surface-tolerance D``; reported in ``report["surface"]``): fewer slivers, the surface
     no longer kept exactly; ``surface_feature_angle``, ``surface_rounds`` and ``adaptive_size``
-    are that stage's ``--feature-angle``, ``--surface-rounds`` and ``--adaptive-size``. ``threads``: worker threads (default, and at most, one per core; the result does
+    are that stage's ``--feature-angle``, ``--surface-rounds`` and ``--adaptive-size``. ``threads``: worker threads (default one per core, at most four a core; the result does
     not depend on it). ``progress``: called with each stage's name (default: the ``biotet``
     logger at level INFO).
 
@@ -507,7 +507,7 @@ def mesh_image(
     ``surface_tolerance=D`` first remeshes the surface within a two-sided Hausdorff distance D
     (``--surface-tolerance D``; reported in ``report["surface"]``): fewer slivers, the surface
     no longer kept exactly; ``surface_feature_angle``, ``surface_rounds`` and ``adaptive_size``
-    are that stage's ``--feature-angle``, ``--surface-rounds`` and ``--adaptive-size``. ``threads``: worker threads (default, and at most, one per core; the result does
+    are that stage's ``--feature-angle``, ``--surface-rounds`` and ``--adaptive-size``. ``threads``: worker threads (default one per core, at most four a core; the result does
     not depend on it). ``progress``: called with each stage's name (default: the ``biotet``
     logger at level INFO). A bare array as ``size_field`` is taken on the image's own grid.
 
@@ -578,7 +578,7 @@ def mesh_file(
     ``surface_tolerance=D`` first remeshes the surface within a two-sided Hausdorff distance D
     (``--surface-tolerance D``; reported in ``report["surface"]``): fewer slivers, the surface
     no longer kept exactly; ``surface_feature_angle``, ``surface_rounds`` and ``adaptive_size``
-    are that stage's ``--feature-angle``, ``--surface-rounds`` and ``--adaptive-size``. ``threads``: worker threads (default, and at most, one per core; the result does
+    are that stage's ``--feature-angle``, ``--surface-rounds`` and ``--adaptive-size``. ``threads``: worker threads (default one per core, at most four a core; the result does
     not depend on it). ``progress``: called with each stage's name (default: the ``biotet``
     logger at level INFO).
 
