@@ -246,6 +246,8 @@ def test_bad_label_volumes_and_options_raise_the_cli_messages(cli, tmp_path):
         biotet.mesh_image(lab, spacing=(2.0, 2.0, 2.0), affine=np.eye(4))
     with pytest.raises(ValueError, match="sizes must be positive"):
         biotet.mesh_image(lab, size_field=np.zeros(lab.shape))
+    with pytest.raises(ValueError, match=r"must have its shape \(10, 10, 10\), not \(3, 3, 3\)"):
+        biotet.mesh_image(lab, size_field=np.ones((3, 3, 3)))
     with pytest.raises(ValueError, match="size_field must be a file path"):
         biotet.mesh(*cube(), size_field=np.ones((2, 2, 2)))
 

@@ -315,7 +315,8 @@ def _affine(spacing: Sequence[float], origin: Sequence[float], affine: Any,
 
 
 def _size_field(size_field: Any, array: str | None,
-                image_affine: list[list[float]] | None = None) -> dict | None:
+                image_affine: list[list[float]] | None = None,
+                image_shape: tuple[int, ...] | None = None) -> dict | None:
     """The native module's form of ``size_field``: a path (with the .vti array name), a
     :class:`SizeField`, or (for :func:`mesh_image`) an array on the image's own grid."""
     if size_field is None:
@@ -339,6 +340,13 @@ def _size_field(size_field: Any, array: str | None,
     v = np.asarray(values, dtype=np.float64)
     if v.ndim != 3:
         raise ValueError(f"size_field: values must be a 3-D array, not of shape {v.shape}")
+    if not isinstance(size_field, SizeField) and image_shape is not None and v.shape != image_shape:
+        # A bare array is read on the image's voxels: another shape would put its values
+        # elsewhere (and leave most of the image outside the field).
+        raise ValueError(
+            f"size_field: an array on the image's grid must have its shape {image_shape}, "
+            f"not {v.shape} (a biotet.SizeField places a grid of its own)"
+        )
     return dict(path=None, array=None, values=v, affine=affine)
 
 
@@ -522,7 +530,7 @@ def mesh_image(
         size, grading, min_size, max_size, region_sizes, resolution, zone, max_voxels,
         steiner, (recover, improve, smooth, polish), surface_tolerance,
         (surface_feature_angle, surface_rounds, adaptive_size),
-        _size_field(size_field, size_field_array, m), exact_surface,
+        _size_field(size_field, size_field_array, m, vol.shape), exact_surface,
     )
     return _tet(_call(_core.mesh_image, vol, m, name, img, o, threads, _progress(progress)))
 
