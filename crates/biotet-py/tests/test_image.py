@@ -246,6 +246,14 @@ def test_bad_label_volumes_and_options_raise_the_cli_messages(cli, tmp_path):
         biotet.mesh_image(lab, spacing=(2.0, 2.0, 2.0), affine=np.eye(4))
     with pytest.raises(ValueError, match="sizes must be positive"):
         biotet.mesh_image(lab, size_field=np.zeros(lab.shape))
+    # Arguments that are no labels or thread counts name themselves (they raised Python's
+    # conversion errors: "can't convert negative int to unsigned").
+    with pytest.raises(ValueError, match=r"keep_labels: -1 is not a label"):
+        biotet.mesh_image(lab, keep_labels=[-1])
+    with pytest.raises(ValueError, match=r"merge: 3000000000 is not a label"):
+        biotet.mesh_image(lab, merge={7: 3_000_000_000})
+    with pytest.raises(ValueError, match=r"threads must be None or a whole number >= 0, not -1"):
+        biotet.mesh_image(lab, threads=-1)
     with pytest.raises(ValueError, match=r"must have its shape \(10, 10, 10\), not \(3, 3, 3\)"):
         biotet.mesh_image(lab, size_field=np.ones((3, 3, 3)))
     with pytest.raises(ValueError, match="size_field must be a file path"):

@@ -114,6 +114,22 @@ def _call(fn: Callable[..., Any], *args: Any, **kwargs: Any) -> Any:
         raise _KINDS.get(kind, MeshingError)(message, triangles) from None
 
 
+def _threads(threads: Any) -> int | None:
+    """``threads`` as the native module takes it: None, or a whole number ≥ 0 (0: one a core)."""
+    if threads is None:
+        return None
+    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 0:
+        raise ValueError(f"threads must be None or a whole number >= 0, not {threads!r}")
+    return int(threads)
+
+
+def _label(x: Any, what: str) -> int:
+    """A region label given as an argument: a whole number in 0..2**31."""
+    if isinstance(x, bool) or not isinstance(x, (int, np.integer)) or not 0 <= x <= _LABEL_MAX:
+        raise ValueError(f"{what}: {x!r} is not a label (an integer in 0..2**31)")
+    return int(x)
+
+
 def _progress(progress: Callable[[str], Any] | None) -> Callable[[str], Any] | None:
     if progress is not None:
         return progress
@@ -354,10 +370,13 @@ def _image_options(keep_labels: Iterable[int] | None, merge: Mapping[int, int] |
                    outside: int, min_component_voxels: int) -> dict:
     """The label options of an image (``--labels``, ``--merge``, ``--outside``,
     ``--min-component-voxels``) as the native module reads them."""
+    if int(min_component_voxels) < 0:
+        raise ValueError(f"min_component_voxels must be >= 0, not {min_component_voxels}")
+    merge = {_label(a, "merge"): _label(b, "merge") for a, b in (merge or {}).items()}
     return dict(
-        keep=None if keep_labels is None else sorted({int(x) for x in keep_labels}),
-        merge=[([int(a)], int(b)) for a, b in sorted((merge or {}).items())],
-        outside=int(outside),
+        keep=None if keep_labels is None else sorted({_label(x, "keep_labels") for x in keep_labels}),
+        merge=[([a], b) for a, b in sorted(merge.items())],
+        outside=_label(outside, "outside"),
         min_component_voxels=int(min_component_voxels),
     )
 
@@ -452,7 +471,7 @@ def mesh(
         (surface_feature_angle, surface_rounds, adaptive_size),
         _size_field(size_field, size_field_array),
     )
-    return _tet(_call(_core.mesh_arrays, v, f, shell, s, name, o, threads, _progress(progress)))
+    return _tet(_call(_core.mesh_arrays, v, f, shell, s, name, o, _threads(threads), _progress(progress)))
 
 
 def mesh_image(
@@ -532,7 +551,7 @@ def mesh_image(
         (surface_feature_angle, surface_rounds, adaptive_size),
         _size_field(size_field, size_field_array, m, vol.shape), exact_surface,
     )
-    return _tet(_call(_core.mesh_image, vol, m, name, img, o, threads, _progress(progress)))
+    return _tet(_call(_core.mesh_image, vol, m, name, img, o, _threads(threads), _progress(progress)))
 
 
 def mesh_file(
@@ -609,7 +628,7 @@ def mesh_file(
         (surface_feature_angle, surface_rounds, adaptive_size),
         _size_field(size_field, size_field_array), exact_surface,
     )
-    return _tet(_call(_core.mesh_files, ps, per_file, img, o, threads, _progress(progress)))
+    return _tet(_call(_core.mesh_files, ps, per_file, img, o, _threads(threads), _progress(progress)))
 
 
 def surface_extract(
@@ -677,19 +696,19 @@ def check(mesh: TetMesh, surface: Surface | tuple[Any, Any] | None = None, *,
     sp, st = _surface_arrays(surface)
     shell = None if labels is None else [int(x) for x in labels]
     return json.loads(_call(_core.check, *_mesh_arrays(mesh), sp, st, shell,
-                            _side_labels(surface), threads=threads))
+                            _side_labels(surface), threads=_threads(threads)))
 
 
 def quality(mesh: TetMesh, *, threads: int | None = None) -> dict:
     """Quality measures of a tet mesh (``biotet quality --json``): dihedral angles, solid
     angles, q, radius ratio, histograms, per region."""
-    return json.loads(_call(_core.quality, *_mesh_arrays(mesh), threads=threads))
+    return json.loads(_call(_core.quality, *_mesh_arrays(mesh), threads=_threads(threads)))
 
 
 def delaunay(points: Any, *, threads: int | None = None) -> TetMesh:
     """The exact Delaunay tetrahedralization of a point cloud (degenerate inputs get a symbolic
     tie-break). Labels are 1."""
-    return _tet(_call(_core.delaunay, _points(points), threads=threads), report=False)
+    return _tet(_call(_core.delaunay, _points(points), threads=_threads(threads)), report=False)
 
 
 def recover(mesh: TetMesh, surface: Surface | tuple[Any, Any], *, steiner: bool = True,
@@ -700,7 +719,7 @@ def recover(mesh: TetMesh, surface: Surface | tuple[Any, Any], *, steiner: bool 
     ``keep_outside``. The report is the recovery's."""
     sp, st = _surface_arrays(surface)
     return _tet(_call(_core.recover_surface, *_mesh_arrays(mesh), sp, st, steiner=steiner,
-                      keep_outside=keep_outside, threads=threads))
+                      keep_outside=keep_outside, threads=_threads(threads)))
 
 
 def improve(mesh: TetMesh, *, threshold: float | None = None, metric: str = "dihedral",
@@ -710,7 +729,7 @@ def improve(mesh: TetMesh, *, threshold: float | None = None, metric: str = "dih
     (``metric="q"``, default threshold 0.2) is under ``threshold``. Points and surface are
     kept."""
     return _tet(_call(_core.improve_mesh, *_mesh_arrays(mesh), threshold=threshold,
-                      metric=metric, threads=threads))
+                      metric=metric, threads=_threads(threads)))
 
 
 def smooth(mesh: TetMesh, surface: Surface | tuple[Any, Any] | None = None, *,
@@ -721,7 +740,7 @@ def smooth(mesh: TetMesh, surface: Surface | tuple[Any, Any] | None = None, *,
     ``feature_angle`` degrees, and corners, stay). ``max_sweeps`` defaults to 10."""
     sp, st = _surface_arrays(surface)
     return _tet(_call(_core.smooth_mesh, *_mesh_arrays(mesh), sp, st, slide=slide,
-                      max_sweeps=max_sweeps, feature_angle=feature_angle, threads=threads))
+                      max_sweeps=max_sweeps, feature_angle=feature_angle, threads=_threads(threads)))
 
 
 _SURFACE_ONLY = (".stl", ".obj", ".off", ".ply")
