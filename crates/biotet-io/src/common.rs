@@ -64,12 +64,14 @@ fn reorient<T>(signs: &[Sign], cells: &mut [T], flip: impl Fn(&mut T)) -> (usize
 /// hold labels up to 2³¹ − 1, so larger ones are refused where they are read.
 pub const MAX_LABEL: u32 = i32::MAX as u32;
 
+/// `v` as a region label, if it is one (`0..=MAX_LABEL`): the one range check of every reader.
+pub fn checked_label(v: i128) -> Option<u32> {
+    u32::try_from(v).ok().filter(|&l| l <= MAX_LABEL)
+}
+
 /// A label from an integer read from a file.
 pub(crate) fn label_of(v: i64) -> std::result::Result<u32, String> {
-    u32::try_from(v)
-        .ok()
-        .filter(|&l| l <= MAX_LABEL)
-        .ok_or_else(|| format!("region label {v} is not in 0..={MAX_LABEL}"))
+    checked_label(v.into()).ok_or_else(|| format!("region label {v} is not in 0..={MAX_LABEL}"))
 }
 
 /// A region label on one side of a surface triangle: [`label_of`], with

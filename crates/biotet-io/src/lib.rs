@@ -59,7 +59,7 @@ mod vtkxml;
 pub mod vtu;
 mod vtu_out;
 
-pub use common::{MAX_LABEL, orient_tets};
+pub use common::{MAX_LABEL, checked_label, orient_tets};
 pub use error::{Error, Result};
 pub use grid::{read_scalar_grid, read_scalar_grid_named};
 pub use image::{is_label_image, read_label_image};

@@ -107,12 +107,9 @@ fn indices_from<const N: usize>(
 fn labels_from(what: &str, a: impl Iterator<Item = i64>) -> PyResult<Vec<u32>> {
     a.enumerate()
         .map(|(i, l)| {
-            u32::try_from(l)
-                .ok()
-                .filter(|&l| l <= biotet_io::MAX_LABEL)
-                .ok_or_else(|| {
-                    PyValueError::new_err(format!("{what}[{i}] = {l} is not a label in 0..2**31"))
-                })
+            biotet_io::checked_label(l.into()).ok_or_else(|| {
+                PyValueError::new_err(format!("{what}[{i}] = {l} is not a label in 0..2**31"))
+            })
         })
         .collect()
 }

@@ -49,9 +49,9 @@ impl ImageArgs {
                     .with_context(|| format!("--merge {m}: bad label"))?;
                 let to = to
                     .trim()
-                    .parse::<u32>()
+                    .parse()
                     .ok()
-                    .filter(|&n| n <= biotet_io::MAX_LABEL)
+                    .and_then(biotet_io::checked_label)
                     .with_context(|| {
                         format!(
                             "--merge {m}: the target is a whole number from 0 to {}",

@@ -98,12 +98,7 @@ pub fn parse_labels(items: &[String], files: &[PathBuf]) -> Result<Vec<Option<Ve
             .with_context(|| format!("--label {item}: {f} is not one of the input surfaces"))?;
         let v: Option<Vec<u32>> = l
             .split(',')
-            .map(|x| {
-                x.trim()
-                    .parse::<u32>()
-                    .ok()
-                    .filter(|&n| n <= biotet_io::MAX_LABEL)
-            })
+            .map(|x| x.trim().parse().ok().and_then(biotet_io::checked_label))
             .collect();
         out[i] = Some(v.with_context(|| {
             format!(

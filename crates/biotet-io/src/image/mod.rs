@@ -19,7 +19,7 @@ use std::path::Path;
 
 use biotet::image::LabelImage;
 
-use crate::common::MAX_LABEL;
+use crate::common::{MAX_LABEL, checked_label};
 use crate::error::{Error, Result};
 
 pub mod metaimage;
@@ -142,10 +142,7 @@ pub(crate) fn float_label(x: f64, at: usize, file: &str) -> Result<u32> {
 }
 
 fn int_label(x: i128, at: usize, file: &str) -> Result<u32> {
-    u32::try_from(x)
-        .ok()
-        .filter(|&l| l <= MAX_LABEL)
-        .ok_or_else(|| not_a_label(x, at, file))
+    checked_label(x).ok_or_else(|| not_a_label(x, at, file))
 }
 
 fn not_a_label(x: impl std::fmt::Display, at: usize, file: &str) -> Error {

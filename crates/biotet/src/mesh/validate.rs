@@ -1087,15 +1087,7 @@ pub fn validate_surface(
         regions.push(rep);
     }
     let components = comps.reports(s, &edges, &comp_flipped);
-    let n_used_points = {
-        let mut used = vec![false; np];
-        for t in &s.triangles {
-            for &v in t {
-                used[v as usize] = true;
-            }
-        }
-        used.iter().filter(|&&u| u).count()
-    };
+    let n_used_points = np - s.n_unused_points();
     Ok(ValidationReport {
         n_points: np,
         n_used_points,
