@@ -10,7 +10,7 @@ use rustc_hash::{FxHashMap, FxHashSet};
 use serde::Serialize;
 
 use crate::delaunay::{Delaunay, DelaunayError};
-use crate::lastresort::recover::recover_built;
+use crate::lastresort::recover::{PIPELINE_FIRST_CAVITY_TETS, recover_built};
 use crate::lastresort::{
     ImproveOptions, ImproveReport, RecoverError, RecoverOptions, RecoverReport, improve,
 };
@@ -57,7 +57,12 @@ impl Default for PipelineOptions {
     fn default() -> PipelineOptions {
         PipelineOptions {
             deploy: DeployOptions::default(),
-            recover: Some(RecoverOptions::default()),
+            // Small cavities first, then an interior point, before large cavities: see
+            // `RecoverOptions::first_cavity_tets`.
+            recover: Some(RecoverOptions {
+                first_cavity_tets: PIPELINE_FIRST_CAVITY_TETS,
+                ..RecoverOptions::default()
+            }),
             // No grown cavities: polish, which follows, fixes what they would (wm_20k: 2,502
             // tets under 10° without them, 2,510 with; brain_20k 1,366 and 1,368) and they were a
             // third of sliver removal's searches' time (the whole run 9% faster on wm_20k,

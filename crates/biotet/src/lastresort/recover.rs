@@ -58,7 +58,16 @@
 //!   strictly inside its kernel (exact check, [`super::kernel`]): the fill through it the search
 //!   finds, or the cone from it. The point is strictly inside a cell, so never on the surface
 //!   (checked exactly against every surface triangle too). This alternates with the
-//!   no-new-point queue while either makes progress.
+//!   no-new-point queue while either makes progress;
+//! - the bounds escalate: the first rounds carve at most [`RecoverOptions::first_cavity_tets`]
+//!   tets, a round without progress lifts that to [`RecoverOptions::max_cavity_tets`], and a
+//!   further one to the wide bounds. A search over a cavity of a hundred tets costs
+//!   milliseconds where one interior point in a small cavity costs microseconds, so a triangle
+//!   that a small cavity recovers with one point is not searched for in a large one (at the
+//!   price of that point: a few on the brain surfaces, seven on a cube with fanned faces). The
+//!   pipeline escalates; `recover` alone by default does not (the bound starts at the full
+//!   size);
+//! - a Steiner point that ends up outside the surface is dropped with the outside tets.
 //!
 //! What still fails (a cell that is star-shaped for no point, within the bounds) is reported:
 //! each unrecovered triangle with its corners, smallest angle and the reason.
@@ -109,6 +118,16 @@ pub struct RecoverOptions {
     pub max_grow: u32,
     /// Cavities larger than this many tets are not searched.
     pub max_cavity_tets: usize,
+    /// With [`Self::allow_interior_steiner`], the first rounds carve at most this many tets
+    /// (the no-new-point queue, then the Steiner fallback, alternating), and only a round without
+    /// progress lifts the bound to [`Self::max_cavity_tets`]: a cavity of a hundred tets or more
+    /// costs milliseconds a search, where one interior point in a small cavity costs
+    /// microseconds (the planar faces of CAD shapes, whose coplanar points the Delaunay splits
+    /// another way: a cube with fanned faces 140 → 20 ms, the trimesh annulus 145 → 40 ms),
+    /// at the price of a few points a no-new-point search would have spared. At or above
+    /// `max_cavity_tets` (the default) no escalation; the pipeline sets
+    /// [`PIPELINE_FIRST_CAVITY_TETS`].
+    pub first_cavity_tets: usize,
     /// As a last resort, add one point strictly inside a failed cavity and search again.
     pub allow_interior_steiner: bool,
     /// A triangle whose cavities failed this many times (each time the whole growth) is not
@@ -137,8 +156,13 @@ const WIDE_GROW: u32 = 6;
 const WIDE_MAX_TETS: usize = 2000;
 const WIDE_NODES: u64 = 2000;
 
+/// The pipeline's [`RecoverOptions::first_cavity_tets`] (measured against 60 and no
+/// escalation over the shape corpus and the brain surfaces: no run slower, the CAD shapes two to
+/// seven times faster in recovery).
+pub const PIPELINE_FIRST_CAVITY_TETS: usize = 40;
+
 /// Rounds of the Steiner fallback, each followed by the no-new-point queue.
-const STEINER_ROUNDS: usize = 8;
+const STEINER_ROUNDS: usize = 10;
 
 /// Node budget of the first, higher-threshold try.
 const FIRST_TRY_NODES: u64 = 500;
@@ -152,6 +176,7 @@ impl Default for RecoverOptions {
             },
             max_grow: 1,
             max_cavity_tets: 300,
+            first_cavity_tets: 300,
             allow_interior_steiner: true,
             max_tries: 1,
             remove_outside: true,
@@ -325,9 +350,16 @@ fn recover_checked(
         drop(at);
         (Recovery::new(mesh, surface, tri_map, *opts), absent.len())
     };
+    // Points from here on are Steiner points.
+    let n_base = r.mesh.points.len();
     if domain != Domain::Convex || reinserted > 0 {
         // Tets put back may hold surface triangles.
         r.scan_present();
+    }
+    // Small cavities first where a point may be added (`first_cavity_tets`).
+    let mut small = opts.allow_interior_steiner && opts.first_cavity_tets < opts.max_cavity_tets;
+    if small {
+        r.opts.max_cavity_tets = opts.first_cavity_tets;
     }
     r.run();
     if opts.allow_interior_steiner {
@@ -339,13 +371,21 @@ fn recover_checked(
             r.tries.clear();
             r.run();
             let after = r.count_missing();
-            if after == 0 || (after == before && (r.wide || !opts.widen)) {
+            if after == 0 {
                 break;
             }
-            // Stuck with small cavities: the next rounds carve wider ones and search longer,
-            // with and without new points (a surface triangle far larger than the interior
-            // spacing needs a wide cavity).
-            if after == before {
+            if after < before {
+                continue;
+            }
+            // Stuck: first the configured cavities, then wide ones searched longer, with and
+            // without new points (a surface triangle far larger than the interior spacing
+            // needs a wide cavity).
+            if small {
+                small = false;
+                r.opts.max_cavity_tets = opts.max_cavity_tets;
+            } else if r.wide || !opts.widen {
+                break;
+            } else {
                 r.widen();
             }
         }
@@ -356,6 +396,8 @@ fn recover_checked(
     r.compact();
     // Also sets the final `is_present`.
     let (removed, conflicts, centroid_tests) = r.relabel(deferred);
+    // Steiner points in cells outside the surface went with the outside tets.
+    r.steiner_points -= r.drop_orphans(n_base);
 
     if cfg!(debug_assertions) {
         r.assert_present();
@@ -2167,6 +2209,46 @@ impl<'a> Recovery<'a> {
             self.work.side.pop();
             self.work.pt_local.pop();
         }
+    }
+
+    /// Drop the points from `n_base` on that no tet uses (renumbering the others); returns how
+    /// many. Run after the outside tets are removed, so only the reports use the incidences
+    /// after it (rebuilt).
+    fn drop_orphans(&mut self, n_base: usize) -> usize {
+        let np = self.mesh.points.len();
+        if np == n_base {
+            return 0;
+        }
+        let mut new_id = vec![u32::MAX; np - n_base];
+        for t in &self.mesh.tets {
+            for &x in t {
+                if x as usize >= n_base {
+                    new_id[x as usize - n_base] = 0;
+                }
+            }
+        }
+        let mut k = n_base;
+        for i in n_base..np {
+            if new_id[i - n_base] != u32::MAX {
+                new_id[i - n_base] = k as u32;
+                self.mesh.points[k] = self.mesh.points[i];
+                k += 1;
+            }
+        }
+        if k == np {
+            return 0;
+        }
+        self.mesh.points.truncate(k);
+        for t in &mut self.mesh.tets {
+            for x in t.iter_mut() {
+                if *x as usize >= n_base {
+                    *x = new_id[*x as usize - n_base];
+                }
+            }
+        }
+        self.surf_start.truncate(k + 1);
+        self.index();
+        np - k
     }
 
     /// Drop dead slots and rebuild adjacency.
