@@ -4,7 +4,12 @@
 use crate::CoreError;
 use biotet::mesh::validate::SurfaceError;
 use pyo3::prelude::*;
+use std::cell::RefCell;
 use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{self, RecvTimeoutError};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
 
 /// What went wrong, for the Python layer to choose the exception class.
 #[derive(Debug, Clone, Copy)]
@@ -80,29 +85,112 @@ impl Failure {
     }
 }
 
+/// A call's cancellation: requested by the waiting Python thread when a signal handler raised
+/// (Ctrl-C), or by the progress callable's own exception, which is then raised in the call's
+/// place.
+#[derive(Default)]
+struct Cancel {
+    requested: AtomicBool,
+    error: Mutex<Option<PyErr>>,
+}
+
+impl Cancel {
+    fn request(&self, e: PyErr) {
+        let mut slot = self.error.lock().unwrap_or_else(|p| p.into_inner());
+        if slot.is_none() {
+            *slot = Some(e);
+        }
+        self.requested.store(true, Ordering::SeqCst);
+    }
+}
+
+thread_local! {
+    /// The cancellation of the call running on this thread (set by [`guarded`]).
+    static CURRENT: RefCell<Option<Arc<Cancel>>> = const { RefCell::new(None) };
+}
+
+/// The unwinding payload that stops a cancelled call at a progress point (raised with
+/// `resume_unwind`, so no panic message is printed).
+struct Interrupted;
+
+/// How often the waiting thread looks at Python's signals.
+const SIGNAL_POLL: Duration = Duration::from_millis(100);
+
+/// The worker thread's stack (the main thread's usual size).
+const STACK: usize = 8 << 20;
+
 /// Run `f` without the GIL, on a pool of `threads` threads when given (at most four a core;
 /// else the global pool, one thread per core), catching panics. Results do not depend on the thread count.
+///
+/// `f` runs on a thread of its own while the calling thread waits, looking at Python's signals
+/// every 100 ms: a signal handler that raises (Ctrl-C's `KeyboardInterrupt`) stops the call
+/// at its next progress point, as does an exception from the progress callable; that
+/// exception is raised in the call's place.
 pub fn guarded<T: Send>(
     py: Python<'_>,
     threads: Option<usize>,
     f: impl FnOnce() -> Result<T, Failure> + Send,
 ) -> PyResult<T> {
-    let out = py.detach(move || {
-        let run = move || catch_unwind(AssertUnwindSafe(f));
-        match threads.filter(|&n| n > 0).map(biotet::usable_threads) {
-            Some(n) => match rayon::ThreadPoolBuilder::new().num_threads(n).build() {
-                Ok(pool) => pool.install(run),
-                Err(e) => Ok(Err(Failure::new(
-                    Kind::Value,
-                    format!("cannot start {n} threads: {e}"),
-                ))),
-            },
-            None => run(),
-        }
+    let cancel = Arc::new(Cancel::default());
+    let out = py.detach(|| {
+        let (done, wait) = mpsc::channel::<()>();
+        std::thread::scope(|scope| {
+            let mine = cancel.clone();
+            let worker = std::thread::Builder::new()
+                .name("biotet".into())
+                .stack_size(STACK)
+                .spawn_scoped(scope, move || {
+                    let run = move || {
+                        CURRENT.with(|c| *c.borrow_mut() = Some(mine));
+                        let r = catch_unwind(AssertUnwindSafe(f));
+                        CURRENT.with(|c| *c.borrow_mut() = None);
+                        r
+                    };
+                    let r = match threads.filter(|&n| n > 0).map(biotet::usable_threads) {
+                        Some(n) => match rayon::ThreadPoolBuilder::new().num_threads(n).build() {
+                            Ok(pool) => pool.install(run),
+                            Err(e) => Ok(Err(Failure::new(
+                                Kind::Value,
+                                format!("cannot start {n} threads: {e}"),
+                            ))),
+                        },
+                        None => run(),
+                    };
+                    let _ = done.send(());
+                    r
+                });
+            let worker = match worker {
+                Ok(w) => w,
+                Err(e) => {
+                    return Ok(Err(Failure::new(
+                        Kind::Meshing,
+                        format!("cannot start a thread: {e}"),
+                    )));
+                }
+            };
+            while let Err(RecvTimeoutError::Timeout) = wait.recv_timeout(SIGNAL_POLL) {
+                if !cancel.requested.load(Ordering::SeqCst)
+                    && let Err(e) = Python::attach(|py| py.check_signals())
+                {
+                    cancel.request(e);
+                }
+            }
+            worker.join().unwrap_or_else(Err)
+        })
     });
     let failure = match out {
         Ok(Ok(v)) => return Ok(v),
         Ok(Err(f)) => f,
+        Err(panic) if panic.is::<Interrupted>() => {
+            let e = cancel
+                .error
+                .lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .take();
+            return Err(e.unwrap_or_else(|| {
+                pyo3::exceptions::PyKeyboardInterrupt::new_err("biotet: interrupted")
+            }));
+        }
         Err(panic) => {
             let what = panic
                 .downcast_ref::<&str>()
@@ -123,11 +211,21 @@ pub fn guarded<T: Send>(
 }
 
 /// Hand a stage name to the Python progress callable, if any (the GIL taken for the call).
-/// Errors raised by the callable are ignored: progress must not stop meshing.
+/// A cancelled call stops here, and an exception from the callable cancels it (on the thread
+/// [`guarded`] runs the call on; elsewhere it is ignored).
 pub fn report_progress(progress: Option<&Py<PyAny>>, stage: &str) {
-    if let Some(cb) = progress {
-        Python::attach(|py| {
-            let _ = cb.call1(py, (stage,));
-        });
+    let cancel = CURRENT.with(|c| c.borrow().clone());
+    if cancel
+        .as_ref()
+        .is_some_and(|c| c.requested.load(Ordering::SeqCst))
+    {
+        std::panic::resume_unwind(Box::new(Interrupted));
+    }
+    if let Some(cb) = progress
+        && let Err(e) = Python::attach(|py| cb.call1(py, (stage,)).map(|_| ()))
+        && let Some(c) = cancel
+    {
+        c.request(e);
+        std::panic::resume_unwind(Box::new(Interrupted));
     }
 }

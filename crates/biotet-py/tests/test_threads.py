@@ -1,8 +1,12 @@
-"""The GIL is released while biotet computes: another Python thread runs meanwhile."""
+"""The GIL is released while biotet computes: another Python thread runs meanwhile, and a
+long call can be stopped."""
 
+import _thread
 import sys
 import threading
 import time
+
+import pytest
 
 import biotet
 from conftest import DATA
@@ -37,3 +41,40 @@ def test_a_python_thread_runs_while_meshing():
     finally:
         sys.setswitchinterval(interval)
     assert ticks > 0
+
+
+def test_an_exception_from_the_progress_callable_stops_the_call():
+    """It is raised in the call's place, at the stage it was raised in (it was ignored, and
+    meshing went on to the end)."""
+    s = biotet.read_surface(DATA / "brain_20k.stl")
+    seen = []
+
+    class Enough(Exception):
+        pass
+
+    def progress(stage):
+        seen.append(stage)
+        if len(seen) == 2:
+            raise Enough(stage)
+
+    with pytest.raises(Enough):
+        biotet.mesh(s.points, s.triangles, progress=progress)
+    assert len(seen) == 2, seen
+
+
+def test_ctrl_c_stops_a_long_call():
+    """Ctrl-C (here `_thread.interrupt_main`, what the signal handler does) during a call stops
+    it at its next stage with KeyboardInterrupt; the waiting thread looks at the signals every
+    100 ms, so the first progress call waits long enough to be seen."""
+    s = biotet.read_surface(DATA / "brain_20k.stl")
+    seen = []
+
+    def progress(stage):
+        seen.append(stage)
+        if len(seen) == 1:
+            _thread.interrupt_main()
+            time.sleep(0.5)
+
+    with pytest.raises(KeyboardInterrupt):
+        biotet.mesh(s.points, s.triangles, surface_tolerance=0.5, progress=progress)
+    assert len(seen) == 1, seen

@@ -456,7 +456,8 @@ def mesh(
     no longer kept exactly; ``surface_feature_angle``, ``surface_rounds`` and ``adaptive_size``
     are that stage's ``--feature-angle``, ``--surface-rounds`` and ``--adaptive-size``. ``threads``: worker threads (default one per core, at most four a core; the result does
     not depend on it). ``progress``: called with each stage's name (default: the ``biotet``
-    logger at level INFO).
+    logger at level INFO); an exception it raises stops the call and is raised in its place, as
+    Ctrl-C's ``KeyboardInterrupt`` is.
 
     Raises :class:`InvalidSurfaceError` for an invalid surface, :class:`MeshingError` if
     meshing cannot finish, ``ValueError`` for bad arguments.
@@ -536,7 +537,8 @@ def mesh_image(
     no longer kept exactly; ``surface_feature_angle``, ``surface_rounds`` and ``adaptive_size``
     are that stage's ``--feature-angle``, ``--surface-rounds`` and ``--adaptive-size``. ``threads``: worker threads (default one per core, at most four a core; the result does
     not depend on it). ``progress``: called with each stage's name (default: the ``biotet``
-    logger at level INFO). A bare array as ``size_field`` is taken on the image's own grid.
+    logger at level INFO); an exception it raises stops the call and is raised in its place, as
+    Ctrl-C's ``KeyboardInterrupt`` is. A bare array as ``size_field`` is taken on the image's own grid.
 
     ``report["image"]`` says what the extraction did and ``report["image_regions"]`` compares
     each region's mesh volume with its voxel volume. Raises ``ValueError`` for bad labels or
@@ -607,7 +609,8 @@ def mesh_file(
     no longer kept exactly; ``surface_feature_angle``, ``surface_rounds`` and ``adaptive_size``
     are that stage's ``--feature-angle``, ``--surface-rounds`` and ``--adaptive-size``. ``threads``: worker threads (default one per core, at most four a core; the result does
     not depend on it). ``progress``: called with each stage's name (default: the ``biotet``
-    logger at level INFO).
+    logger at level INFO); an exception it raises stops the call and is raised in its place, as
+    Ctrl-C's ``KeyboardInterrupt`` is.
 
     Raises ``FileNotFoundError``/:class:`BiotetFileError` (``OSError``) for unreadable files,
     and otherwise as :func:`mesh` and :func:`mesh_image`.
