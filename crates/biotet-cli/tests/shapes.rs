@@ -228,3 +228,49 @@ fn a_failed_recovery_lists_only_its_own_failures() {
         );
     }
 }
+
+/// A cube of 12 triangles meshed at a tenth of its side: kept exactly, the tets on its faces
+/// cannot all be well shaped, and the report says so and names the remedy; with the surface
+/// stage the faces are remeshed to the size and every tet is above 10°.
+#[test]
+fn triangles_far_larger_than_the_size_get_a_note_and_a_remedy() {
+    let dir = tempfile::tempdir().unwrap();
+    let cube = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/shapes/tm_box.off");
+    let (cube, out) = (cube.to_str().unwrap(), dir.path().join("cube.vtu"));
+    let out = out.to_str().unwrap();
+    let text = biotet(&["mesh", cube, "--size", "0.1", "-o", out]);
+    assert!(text.status.success());
+    let stdout = String::from_utf8_lossy(&text.stdout);
+    assert!(
+        stdout.contains("12 input triangles are over 3 times the size")
+            && stdout.contains("--surface-tolerance"),
+        "{stdout}"
+    );
+    let exact = biotet(&["mesh", cube, "--size", "0.1", "-o", out, "--json"]);
+    let j: serde_json::Value = serde_json::from_slice(&exact.stdout).unwrap();
+    assert_eq!(j["input_triangles_over_size"], 12);
+    assert!(j["forcing"]["n_unforced_dihedral_lt_10"].as_u64().unwrap() > 0);
+    let staged = biotet(&[
+        "mesh",
+        cube,
+        "--size",
+        "0.1",
+        "--surface-tolerance",
+        "0.001",
+        "-o",
+        out,
+        "--json",
+    ]);
+    assert!(staged.status.success());
+    let j: serde_json::Value = serde_json::from_slice(&staged.stdout).unwrap();
+    assert_eq!(j["input_triangles_over_size"], 0);
+    assert!(
+        j["quality"]["min_dihedral_deg"].as_f64().unwrap() > 10.0,
+        "{}",
+        j["quality"]
+    );
+    // The surface moved (within 0.001): the mesh is checked on its own.
+    assert!(j["surface"]["hausdorff_in_to_out"].as_f64().unwrap() <= 0.001);
+    let c = biotet(&["check", out, "-q"]);
+    assert!(c.status.success(), "{}", String::from_utf8_lossy(&c.stdout));
+}

@@ -4,6 +4,7 @@ use crate::memory::{StagePeaks, map_mesh_sized_blocks, release_free_memory};
 use crate::{Common, output, plot, progress::Stage};
 use anyhow::{Context, Result};
 use biotet::mesh::shells::Part;
+use biotet::mesh::surface::SurfaceMesh;
 use biotet::pipeline::{PipelineOptions, mesh_surface};
 use biotet::quality::{QualityReport, forced};
 use biotet::sizing::{SizeSpec, Sizing, SizingOptions};
@@ -277,6 +278,13 @@ pub fn run(a: Args) -> Result<ExitCode> {
     let sizing = Sizing::new(&surface, sizing).context("sizing")?;
     // Part of meshing: the surface-derived size is built from the surface here.
     let seconds_sizing = clock.elapsed().as_secs_f64();
+    // Kept exactly, a surface triangle far larger than the size cannot have well-shaped tets
+    // on it among nodes at that size: counted, for a note where such tets remain.
+    let over_size = if surface_report.is_none() {
+        triangles_over_size(&surface, &sizing)
+    } else {
+        0
+    };
 
     let mut opts = PipelineOptions::default();
     opts.deploy.resolution = a.resolution;
@@ -423,6 +431,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
                 .map(|(stage, kb)| json!({"stage": stage, "peak_rss_kb": kb}))
                 .collect::<Vec<_>>(),
             "mesh_bytes": mesh.bytes(),
+            "input_triangles_over_size": over_size,
             "image": image,
             "image_regions": image
                 .as_ref()
@@ -504,6 +513,13 @@ pub fn run(a: Args) -> Result<ExitCode> {
             forcing.n_unforced_dihedral_lt_10,
             forcing.cause_text()
         );
+        if over_size > 0 && forcing.n_unforced_dihedral_lt_10 > 0 {
+            text += &format!(
+                "\nnote: {over_size} input triangles are over {OVER_SIZE} times the size where \
+                 they lie, and kept exactly the tets on them cannot all be well shaped: \
+                 --surface-tolerance D remeshes the surface to the size, moving it at most D"
+            );
+        }
         if let Some(i) = &image {
             text += "\n";
             text += super::extract::region_text(&super::extract::region_volumes(
@@ -536,4 +552,31 @@ pub fn run(a: Args) -> Result<ExitCode> {
         return Ok(ExitCode::from(crate::EXIT_INVALID));
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// A surface triangle whose longest edge is over this many times the size at its centroid is
+/// counted by [`triangles_over_size`].
+const OVER_SIZE: f64 = 3.0;
+
+/// Surface triangles whose longest edge is over [`OVER_SIZE`] times the size at their centroid
+/// (in the region on either side with the smaller size).
+fn triangles_over_size(surface: &SurfaceMesh, sizing: &Sizing) -> usize {
+    (0..surface.triangles.len())
+        .filter(|&t| {
+            let c = surface.corners(t);
+            let longest = (0..3)
+                .map(|k| {
+                    let (p, q) = (c[k], c[(k + 1) % 3]);
+                    ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
+                })
+                .fold(0.0, f64::max);
+            let g = [0, 1, 2].map(|k| (c[0][k] + c[1][k] + c[2][k]) / 3.0);
+            let size = surface.sides[t]
+                .iter()
+                .filter(|&&r| r != 0)
+                .map(|&r| sizing.at(g, r))
+                .fold(f64::INFINITY, f64::min);
+            size.is_finite() && longest > OVER_SIZE * size
+        })
+        .count()
 }
