@@ -47,6 +47,10 @@ pub use folds::{FOLD_ANGLE, min_fold};
 mod necks;
 mod sweep;
 
+/// The smallest angle a split may make where the two triangles it splits are above it
+/// (degrees; see [`Remesher::split`]).
+const SPLIT_FLOOR_DEG: f64 = 3.0;
+
 /// Smallest and largest angle of a triangle, in degrees.
 pub fn angles_deg(t: &[P3; 3]) -> (f64, f64) {
     let mut lo = 180.0f64;
@@ -756,6 +760,17 @@ impl<'a> Remesher<'a> {
         let halves = [[pa, m, pc], [m, pb, pc], [pb, m, pd], [m, pa, pd]];
         if halves.iter().any(is_degenerate) {
             return false;
+        }
+        // Halves may be worse than the pair (flips and moves mend that), but not below
+        // SPLIT_FLOOR_DEG unless the pair already was: splitting the long edges of a needle
+        // strip halves its angle at every round (voxels six times longer one way: 9.5° became
+        // 2e-4° in four rounds, and the kept rims there held them to the end). The repair's
+        // splits bring the surface within the tolerance, which comes first.
+        if !self.repairing {
+            let floor = self.worst_angle(&[t1, t2]).min(SPLIT_FLOOR_DEG);
+            if halves.iter().any(|h| min_angle_deg(h) < floor) {
+                return false;
+            }
         }
         // The rounded midpoint may lie off the edge: where another sheet passes that close,
         // the halves can meet it though the two triangles did not.
