@@ -333,8 +333,8 @@ def test_voxels_six_times_longer_one_way_mesh_without_flat_tets():
 def test_thick_slices_at_the_border_make_no_flat_triangles():
     # Grey and white matter in 0.5 x 0.5 x 3 mm voxels where their interface meets the image's
     # border (tests/data/ridge_aniso_crop.nii.gz): the kept triple lines there are staircases of
-    # 3 mm steps, and the stage's rounds split the needle strips along them again every round,
-    # halving their angles: 1e-6° triangles, 0.00° tets, 705 under 10°. Splits now stop at 3°.
+    # 3 mm steps, and the stage's rounds split the triangles on them again every round, their far
+    # corners closing in: 1e-6° triangles, 0.00° tets, 705 under 10°. Splits there now stop at 3°.
     m = biotet.mesh_file(DATA / "ridge_aniso_crop.nii.gz")
     s = m.report["surface"]
     assert s["min_angle_out"] >= 3.0, s["min_angle_out"]

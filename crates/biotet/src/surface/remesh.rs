@@ -165,6 +165,8 @@ pub struct Remesher<'a> {
     vt: Vec<Vec<u32>>,
     fixed: Vec<bool>,
     feature: FxHashSet<(u32, u32)>,
+    /// The ends of the kept edges (see [`Self::split`]).
+    kept_ends: FxHashSet<u32>,
     input: &'a PatchIndex,
     samples: &'a InputSamples,
     /// Per input sample: the triangle that covers it (within the working tolerance) and an
@@ -249,6 +251,7 @@ impl<'a> Remesher<'a> {
             vt,
             fixed: f.fixed.clone(),
             feature: f.edges.clone(),
+            kept_ends: f.edges.iter().flat_map(|&(a, b)| [a, b]).collect(),
             input,
             samples,
             cover: samples.tri.iter().map(|&t| (t, 0.0)).collect(),
@@ -761,14 +764,18 @@ impl<'a> Remesher<'a> {
         if halves.iter().any(is_degenerate) {
             return false;
         }
-        // Halves may be worse than the pair (flips and moves mend that), but not below
-        // SPLIT_FLOOR_DEG unless the pair already was: splitting the long edges of a needle
-        // strip halves its angle at every round (voxels six times longer one way: 9.5° became
-        // 2e-4° in four rounds, and the kept rims there held them to the end). The repair's
-        // splits bring the surface within the tolerance, which comes first.
+        // At a kept edge, halves may be worse than the pair (flips and moves mend that) but not
+        // below SPLIT_FLOOR_DEG unless the pair already was: a triangle on a kept edge longer
+        // than the target has its other edges split every round, its far corner closing in on
+        // the kept edge (voxels six times longer one way: 9.5° became 2e-4° in four rounds).
+        // Elsewhere splits are free (a long thin cylinder needs them: with the floor everywhere
+        // one 400 long kept 1.2° triangles). The repair's splits bring the surface within the
+        // tolerance, which comes first.
         if !self.repairing {
             let floor = self.worst_angle(&[t1, t2]).min(SPLIT_FLOOR_DEG);
-            if halves.iter().any(|h| min_angle_deg(h) < floor) {
+            if halves.iter().any(|h| min_angle_deg(h) < floor)
+                && [t1, t2].iter().any(|&t| self.near_kept_edge(t))
+            {
                 return false;
             }
         }
@@ -814,6 +821,14 @@ impl<'a> Remesher<'a> {
             self.size[mi as usize] = h;
         }
         true
+    }
+
+    /// Whether triangle `t` has a corner on a kept edge (a feature, interface rim or triple
+    /// line).
+    fn near_kept_edge(&self, t: u32) -> bool {
+        self.tris[t as usize]
+            .iter()
+            .any(|v| self.kept_ends.contains(v))
     }
 
     /// Collapse edge `ab` by removing `a` (its triangles then use `b`), if every check passes.
