@@ -2,6 +2,7 @@
 long call can be stopped."""
 
 import _thread
+import signal
 import sys
 import threading
 import time
@@ -75,6 +76,12 @@ def test_ctrl_c_stops_a_long_call():
             _thread.interrupt_main()
             time.sleep(0.5)
 
-    with pytest.raises(KeyboardInterrupt):
-        biotet.mesh(s.points, s.triangles, surface_tolerance=0.5, progress=progress)
+    # Python's own Ctrl-C handler, as in a terminal (a run started in the background inherits
+    # SIGINT ignored, and then interrupt_main does nothing).
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            biotet.mesh(s.points, s.triangles, surface_tolerance=0.5, progress=progress)
+    finally:
+        signal.signal(signal.SIGINT, before)
     assert len(seen) == 1, seen
