@@ -397,7 +397,7 @@ fn recover_checked(
     // Also sets the final `is_present`.
     let (removed, conflicts, centroid_tests) = r.relabel(deferred);
     // Steiner points in cells outside the surface went with the outside tets.
-    r.steiner_points -= r.drop_orphans(n_base);
+    r.steiner_points = r.steiner_points.saturating_sub(r.drop_orphans(n_base));
 
     if cfg!(debug_assertions) {
         r.assert_present();
