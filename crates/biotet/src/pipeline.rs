@@ -560,29 +560,7 @@ fn compact(
     neighbors: Vec<[u32; 4]>,
     labels: Vec<u32>,
 ) -> TetMesh {
-    // Used points' new indices (u32::MAX for the unused).
-    let mut new_index = vec![u32::MAX; points.len()];
-    for t in &tets {
-        for &v in t {
-            new_index[v as usize] = 0;
-        }
-    }
-    let mut k = 0;
-    for i in 0..points.len() {
-        if new_index[i] != u32::MAX {
-            new_index[i] = k as u32;
-            points[k] = points[i];
-            k += 1;
-        }
-    }
-    if k != points.len() {
-        points.truncate(k);
-        for t in &mut tets {
-            for v in t.iter_mut() {
-                *v = new_index[*v as usize];
-            }
-        }
-    }
+    crate::mesh::drop_unused_points(&mut points, tets.as_flattened_mut(), 0);
     let mut mesh = TetMesh {
         points,
         tets,

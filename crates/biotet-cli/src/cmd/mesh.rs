@@ -3,6 +3,7 @@
 use crate::memory::{StagePeaks, map_mesh_sized_blocks, release_free_memory};
 use crate::{Common, output, plot, progress::Stage};
 use anyhow::{Context, Result};
+use biotet::geom::vec3::{norm, sub};
 use biotet::mesh::shells::Part;
 use biotet::mesh::surface::SurfaceMesh;
 use biotet::pipeline::{PipelineOptions, mesh_surface};
@@ -565,10 +566,7 @@ fn triangles_over_size(surface: &SurfaceMesh, sizing: &Sizing) -> usize {
         .filter(|&t| {
             let c = surface.corners(t);
             let longest = (0..3)
-                .map(|k| {
-                    let (p, q) = (c[k], c[(k + 1) % 3]);
-                    ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
-                })
+                .map(|k| norm(sub(c[k], c[(k + 1) % 3])))
                 .fold(0.0, f64::max);
             let g = [0, 1, 2].map(|k| (c[0][k] + c[1][k] + c[2][k]) / 3.0);
             let size = surface.sides[t]

@@ -2215,40 +2215,16 @@ impl<'a> Recovery<'a> {
     /// many. Run after the outside tets are removed, so only the reports use the incidences
     /// after it (rebuilt).
     fn drop_orphans(&mut self, n_base: usize) -> usize {
-        let np = self.mesh.points.len();
-        if np == n_base {
-            return 0;
+        let dropped = crate::mesh::drop_unused_points(
+            &mut self.mesh.points,
+            self.mesh.tets.as_flattened_mut(),
+            n_base,
+        );
+        if dropped > 0 {
+            self.surf_start.truncate(self.mesh.points.len() + 1);
+            self.index();
         }
-        let mut new_id = vec![u32::MAX; np - n_base];
-        for t in &self.mesh.tets {
-            for &x in t {
-                if x as usize >= n_base {
-                    new_id[x as usize - n_base] = 0;
-                }
-            }
-        }
-        let mut k = n_base;
-        for i in n_base..np {
-            if new_id[i - n_base] != u32::MAX {
-                new_id[i - n_base] = k as u32;
-                self.mesh.points[k] = self.mesh.points[i];
-                k += 1;
-            }
-        }
-        if k == np {
-            return 0;
-        }
-        self.mesh.points.truncate(k);
-        for t in &mut self.mesh.tets {
-            for x in t.iter_mut() {
-                if *x as usize >= n_base {
-                    *x = new_id[*x as usize - n_base];
-                }
-            }
-        }
-        self.surf_start.truncate(k + 1);
-        self.index();
-        np - k
+        dropped
     }
 
     /// Drop dead slots and rebuild adjacency.

@@ -15,6 +15,42 @@ pub mod tet;
 pub mod tri;
 pub mod validate;
 
+/// Drop the points from index `from` on that no entry of `corners` names (the element
+/// corners of a mesh, flattened), keeping the others' order, and renumber `corners`; returns how
+/// many went. One pass to mark, one to move, one to renumber (skipped when nothing went): it runs
+/// on whole meshes, in place.
+pub fn drop_unused_points(points: &mut Vec<[f64; 3]>, corners: &mut [u32], from: usize) -> usize {
+    let n = points.len();
+    if from >= n {
+        return 0;
+    }
+    // New indices of the points from `from` on (u32::MAX for the unused).
+    let mut new_index = vec![u32::MAX; n - from];
+    for &v in corners.iter() {
+        if let Some(x) = (v as usize).checked_sub(from) {
+            new_index[x] = 0;
+        }
+    }
+    let mut k = from;
+    for i in from..n {
+        if new_index[i - from] != u32::MAX {
+            new_index[i - from] = k as u32;
+            points[k] = points[i];
+            k += 1;
+        }
+    }
+    if k == n {
+        return 0;
+    }
+    points.truncate(k);
+    for v in corners.iter_mut() {
+        if let Some(x) = (*v as usize).checked_sub(from) {
+            *v = new_index[x];
+        }
+    }
+    n - k
+}
+
 /// The exact identity of a point's coordinates, for matching points across meshes (`-0.0` and
 /// `0.0` are the same point).
 #[inline]

@@ -146,24 +146,7 @@ impl SurfaceMesh {
 
     /// Drop the points no triangle uses, keeping the others' order; returns how many went.
     pub fn drop_unused_points(&mut self) -> usize {
-        let mut new_index = vec![u32::MAX; self.points.len()];
-        for &v in self.triangles.iter().flatten() {
-            new_index[v as usize] = 0;
-        }
-        let mut k = 0;
-        for (i, x) in new_index.iter_mut().enumerate() {
-            if *x != u32::MAX {
-                *x = k as u32;
-                self.points[k] = self.points[i];
-                k += 1;
-            }
-        }
-        let dropped = self.points.len() - k;
-        self.points.truncate(k);
-        for t in &mut self.triangles {
-            *t = t.map(|v| new_index[v as usize]);
-        }
-        dropped
+        super::drop_unused_points(&mut self.points, self.triangles.as_flattened_mut(), 0)
     }
 
     /// Append another surface (points are not merged).
