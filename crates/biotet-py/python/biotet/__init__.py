@@ -515,8 +515,8 @@ def mesh_image(
     centred at ``origin + spacing * (i, j, k)``, or at ``affine @ (i, j, k, 1)`` when an
     ``affine`` (4×4 or 3×4, voxel to world, e.g. nibabel's ``img.affine``) is given. Each
     non-zero value is a region whose tets keep that value as their label; 0 is the outside.
-    The surface is the voxel faces between labels (an oblique image is meshed in its
-    axis-aligned frame and rotated to world), remeshed by the surface stage within half the
+    The surface is the voxel faces between labels (an oblique image is meshed in a frame
+    rotated to world, a sheared one too: angles and distances are the world's), remeshed by the surface stage within half the
     smallest voxel spacing unless ``surface_tolerance`` says otherwise; ``exact_surface=True``
     keeps the voxel faces exactly instead (``--exact-surface``: each region's mesh volume is
     then its voxel volume, its boundary a staircase).

@@ -28,8 +28,9 @@
 //!
 //! Points are in the image's world coordinates. For an oblique image (a rotated voxel grid) the
 //! corners of one flat face are then coplanar only up to rounding; to mesh, extract in the
-//! image's axis-aligned frame ([`LabelImage::to_frame`]) and map the mesh to world at the end
-//! ([`super::map_points`]), as `biotet mesh IMAGE` does.
+//! image's frame ([`LabelImage::to_frame`]: axis-aligned unless the grid is sheared) and map the
+//! mesh to world at the end ([`super::map_points`]), as `biotet mesh IMAGE` does. A sheared
+//! grid's faces are parallelograms, split along their shorter diagonals.
 //!
 //! The surface is staircase-shaped; its smoothing belongs to the surface stage (issue 20:
 //! `surface::improve` within a tolerance, by default [`LabelImage::default_surface_tolerance`],
@@ -79,6 +80,9 @@ pub fn faces(img: &LabelImage) -> SurfaceMesh {
         }
     };
     let flip = img.determinant() < 0.0;
+    // Not a scaled permutation: the frame of a sheared grid ([`LabelImage::to_frame`]).
+    let m = &img.voxel_to_world;
+    let sheared = (0..3).any(|c| (0..3).filter(|&r| m[r][c] != 0.0).count() != 1);
     let mut point_of: FxHashMap<usize, u32> = FxHashMap::default();
     let mut mesh = SurfaceMesh::default();
     let mut corner = |a: usize, b: usize, c: usize, mesh: &mut SurfaceMesh| -> u32 {
@@ -121,7 +125,19 @@ pub fn faces(img: &LabelImage) -> SurfaceMesh {
                     // Delaunay's symbolic perturbation picks for four cocircular points (the
                     // highest index is perturbed most), so fewer triangles need recovery.
                     let top = (0..4).max_by_key(|&c| q[c]).expect("4 corners");
-                    if top % 2 == 0 {
+                    // A sheared grid's face is a parallelogram: its shorter diagonal is the
+                    // Delaunay one (the angles facing it are the acute ones).
+                    let even = if sheared {
+                        let p = q.map(|x| mesh.points[x as usize]);
+                        let d = |a: usize, b: usize| {
+                            (0..3).map(|k| (p[a][k] - p[b][k]).powi(2)).sum::<f64>()
+                        };
+                        let (d02, d13) = (d(0, 2), d(1, 3));
+                        if d02 == d13 { top % 2 == 0 } else { d13 < d02 }
+                    } else {
+                        top % 2 == 0
+                    };
+                    if even {
                         mesh.triangles.push([q[0], q[1], q[3]]);
                         mesh.triangles.push([q[1], q[2], q[3]]);
                     } else {

@@ -153,17 +153,25 @@ impl LabelImage {
     }
 
     /// For an oblique image (a voxel-to-world map that is not a scaled permutation), split the
-    /// map into an axis-aligned *frame* and a frame → world map: sets `voxel_to_world` to
-    /// `diag(±spacing)` (no offset; x negated when the map reverses orientation) and returns
-    /// the map `M` with `world = M · frame`, whose linear part has positive
-    /// determinant (a rotation when the voxel axes are orthogonal). `None` when the map is
-    /// already axis-aligned.
+    /// map into a *frame* and a frame → world map `M` (returned) with `world = M · frame`, whose
+    /// linear part is a rotation (to rounding), so that angles and distances measured in the
+    /// frame are the world's. `None` when the map is already axis-aligned.
     ///
-    /// Why: the grid corners of one voxel face are exactly coplanar in an axis-aligned frame
-    /// (they share one coordinate), but not after a rotation in floating point, where the
-    /// staircase surface's flat parts become slightly folded and a mesher may fill the fold with
-    /// a flat tet. Meshing in the frame and mapping the mesh to world at the end keeps flat
-    /// parts flat and, the map being a rotation, every angle.
+    /// - Orthogonal voxel axes (a rotated grid): the frame is axis-aligned, `voxel_to_world`
+    ///   becomes `diag(±spacing)` (no offset; x negated when the map reverses orientation).
+    ///   Why: the grid corners of one voxel face are exactly coplanar there (they share one
+    ///   coordinate), but not after a rotation in floating point, where the staircase
+    ///   surface's flat parts become slightly folded and a mesher may fill the fold with a flat
+    ///   tet.
+    /// - Sheared voxel axes (a CT gantry tilt, say): no frame is both axis-aligned and
+    ///   isometric to world, and an axis-aligned one would shear the mesh made in it on the way
+    ///   out (its angles, and the surface stage's distances, measured in the wrong metric). The
+    ///   frame is the symmetric factor `P` of the polar decomposition `A = R·P` of the map's
+    ///   linear part (`R` a rotation; with x negated first when `A` reverses orientation), and
+    ///   `M` is `R` with the offset.
+    ///
+    /// Axes count as orthogonal when every pair's cosine is under 1e-6: a map stored in single
+    /// precision (NIfTI's) is orthogonal to about 1e-7.
     pub fn to_frame(&mut self) -> Option<[[f64; 4]; 4]> {
         let m = self.voxel_to_world;
         let aligned = (0..3).all(|c| (0..3).filter(|&r| m[r][c] != 0.0).count() == 1);
@@ -172,14 +180,37 @@ impl LabelImage {
         }
         let s = self.spacing();
         let sign = if self.determinant() < 0.0 { -1.0 } else { 1.0 };
-        let scale = [sign * s[0], s[1], s[2]];
+        let orthogonal = (0..3).all(|a| {
+            let b = (a + 1) % 3;
+            let d: f64 = (0..3).map(|r| m[r][a] * m[r][b]).sum();
+            d.abs() < 1e-6 * s[a] * s[b]
+        });
         let mut f = [[0.0; 4]; 4];
         let mut to_world = [[0.0; 4]; 4];
-        for r in 0..3 {
-            f[r][r] = scale[r];
-            for c in 0..3 {
-                to_world[r][c] = m[r][c] / scale[c];
+        if orthogonal {
+            let scale = [sign * s[0], s[1], s[2]];
+            for r in 0..3 {
+                f[r][r] = scale[r];
+                for c in 0..3 {
+                    to_world[r][c] = m[r][c] / scale[c];
+                }
             }
+        } else {
+            // The rotation of the map with x turned to positive determinant; the frame is what
+            // it leaves, Rᵀ·A (symmetric but for the sign of its first column).
+            let a: [[f64; 3]; 3] = std::array::from_fn(|r| std::array::from_fn(|c| m[r][c]));
+            let turned = std::array::from_fn(|r| {
+                std::array::from_fn(|c| if c == 0 { sign * a[r][0] } else { a[r][c] })
+            });
+            let rot = polar_rotation(turned);
+            for r in 0..3 {
+                for c in 0..3 {
+                    to_world[r][c] = rot[r][c];
+                    f[r][c] = (0..3).map(|k| rot[k][r] * a[k][c]).sum();
+                }
+            }
+        }
+        for r in 0..3 {
             to_world[r][3] = m[r][3];
         }
         f[3][3] = 1.0;
@@ -198,6 +229,38 @@ impl LabelImage {
         v.sort_unstable();
         v
     }
+}
+
+/// The rotation `R` of the polar decomposition `A = R·P` (`P` symmetric positive definite) of
+/// an invertible 3×3 matrix with positive determinant: Newton's iteration `X ← (γX + X⁻ᵀ/γ)/2`
+/// with determinant scaling (`γ = |det X|^(−1/3)`), which converges quadratically; stopped when
+/// a step changes no entry by more than 1e-15 of the matrix's size.
+fn polar_rotation(a: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    let mut x = a;
+    for _ in 0..100 {
+        let det = x[0][0] * (x[1][1] * x[2][2] - x[1][2] * x[2][1])
+            - x[0][1] * (x[1][0] * x[2][2] - x[1][2] * x[2][0])
+            + x[0][2] * (x[1][0] * x[2][1] - x[1][1] * x[2][0]);
+        // X⁻ᵀ is the cofactor matrix over the determinant.
+        let cof = |r: usize, c: usize| {
+            let (r1, r2) = ((r + 1) % 3, (r + 2) % 3);
+            let (c1, c2) = ((c + 1) % 3, (c + 2) % 3);
+            x[r1][c1] * x[r2][c2] - x[r1][c2] * x[r2][c1]
+        };
+        let g = det.abs().powf(-1.0 / 3.0);
+        let next: [[f64; 3]; 3] = std::array::from_fn(|r| {
+            std::array::from_fn(|c| 0.5 * (g * x[r][c] + cof(r, c) / (g * det)))
+        });
+        let size = next.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+        let step = (0..9).fold(0.0f64, |m, k| {
+            m.max((next[k / 3][k % 3] - x[k / 3][k % 3]).abs())
+        });
+        x = next;
+        if step <= 1e-15 * size {
+            break;
+        }
+    }
+    x
 }
 
 #[cfg(test)]
@@ -226,5 +289,33 @@ mod tests {
         let lin = LabelImage::new([1, 1, 1], to_world, vec![0]).unwrap();
         assert!((lin.determinant() - 1.0).abs() < 1e-12);
         assert!(img.clone().to_frame().is_none());
+    }
+
+    /// Thick sheared slices (0.5 × 0.5 × 3 voxels, slices tilted 25°, the grid turned): the
+    /// polar factor is a rotation and what it leaves is symmetric positive definite.
+    #[test]
+    fn polar_rotation_of_a_thick_tilted_grid() {
+        let (c, s) = (0.3f64.cos(), 0.3f64.sin());
+        let t = 25f64.to_radians().tan() * 3.0;
+        let a0 = [[0.5, 0.0, 0.0], [0.0, 0.5, t], [0.0, 0.0, 3.0]];
+        let turn = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]];
+        let a: [[f64; 3]; 3] = std::array::from_fn(|r| {
+            std::array::from_fn(|k| (0..3).map(|j| turn[r][j] * a0[j][k]).sum())
+        });
+        let rot = polar_rotation(a);
+        let p: [[f64; 3]; 3] = std::array::from_fn(|r| {
+            std::array::from_fn(|k| (0..3).map(|j| rot[j][r] * a[j][k]).sum())
+        });
+        for i in 0..3 {
+            for j in 0..3 {
+                let d: f64 = (0..3).map(|r| rot[r][i] * rot[r][j]).sum();
+                assert!(
+                    (d - f64::from(u8::from(i == j))).abs() < 1e-14,
+                    "RᵀR {i}{j}: {d}"
+                );
+                assert!((p[i][j] - p[j][i]).abs() < 1e-13, "P {p:?}");
+            }
+            assert!(p[i][i] > 0.0);
+        }
     }
 }
