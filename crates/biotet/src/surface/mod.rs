@@ -27,6 +27,7 @@ pub mod features;
 pub mod grid;
 pub mod guard;
 pub mod hausdorff;
+pub mod presplit;
 pub mod remesh;
 pub mod size;
 
@@ -36,6 +37,7 @@ use crate::geom::vec3::volume6;
 use crate::mesh::surface::SurfaceMesh;
 use crate::mesh::validate::{self, ValidateOptions, validate_surface};
 use bvh::PatchIndex;
+use features::Features;
 use rustc_hash::{FxHashMap, FxHashSet};
 
 /// What [`improve`] does.
@@ -348,16 +350,38 @@ pub fn improve_with_progress(
         .iter()
         .map(|t| t.iter().map(|&v| point_size[v as usize]).fold(l, f64::min))
         .collect();
-    let mut r = remesh::Remesher::new(
-        surface,
-        &f,
-        &index,
-        &samples,
-        &point_size,
-        &tri_size,
-        l,
-        0.7 * d,
-    );
+    // Long edges cut to the target first: the rounds' midpoint splits would fan them out.
+    let start = presplit::presplit(surface, &f, &samples, &point_size, l);
+    let mut r = match &start {
+        Some(st) => {
+            let f = Features {
+                fixed: st.fixed.clone(),
+                ..f.clone()
+            };
+            remesh::Remesher::new(
+                &st.mesh,
+                &f,
+                &index,
+                &samples,
+                Some(&st.cover),
+                &st.point_size,
+                &tri_size,
+                l,
+                0.7 * d,
+            )
+        }
+        None => remesh::Remesher::new(
+            surface,
+            &f,
+            &index,
+            &samples,
+            None,
+            &point_size,
+            &tri_size,
+            l,
+            0.7 * d,
+        ),
+    };
     // The loop keeps its samples within 0.7 D; the final measure then has room.
     r.spacing = (0.25 * l).max(d);
     r.target_angle = opts.target_angle_deg;

@@ -218,13 +218,17 @@ pub struct Remesher<'a> {
 }
 
 impl<'a> Remesher<'a> {
-    /// Start from `s` with its features, projecting onto `input`.
+    /// Start from `s` with its features, projecting onto `input`. `s` is the input, or the
+    /// input with its long edges cut ([`super::presplit`]), whose triangle covering each input
+    /// sample and its distance `cover` then gives (else each sample starts on the triangle it
+    /// was taken from).
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         s: &SurfaceMesh,
         f: &Features,
         input: &'a PatchIndex,
         samples: &'a InputSamples,
+        cover: Option<&[(u32, f64)]>,
         point_size: &[f64],
         tri_size: &'a [f64],
         l: f64,
@@ -232,9 +236,12 @@ impl<'a> Remesher<'a> {
     ) -> Remesher<'a> {
         let mut vt = vec![Vec::new(); s.points.len()];
         let mut grid = Grid::new(l.max(1e-300));
-        // Each sample starts on the triangle it was taken from.
+        let cover: Vec<(u32, f64)> = match cover {
+            Some(c) => c.to_vec(),
+            None => samples.tri.iter().map(|&t| (t, 0.0)).collect(),
+        };
         let mut covers = vec![Vec::new(); s.triangles.len()];
-        for (i, &t) in samples.tri.iter().enumerate() {
+        for (i, &(t, _)) in cover.iter().enumerate() {
             covers[t as usize].push(i as u32);
         }
         for (t, tri) in s.triangles.iter().enumerate() {
@@ -254,7 +261,7 @@ impl<'a> Remesher<'a> {
             kept_ends: f.edges.iter().flat_map(|&(a, b)| [a, b]).collect(),
             input,
             samples,
-            cover: samples.tri.iter().map(|&t| (t, 0.0)).collect(),
+            cover,
             covers,
             dev: vec![(f64::INFINITY, 0); s.triangles.len()],
             clock: 0,
@@ -1503,6 +1510,7 @@ pub(super) mod tests {
                 &self.f,
                 &self.index,
                 &self.samples,
+                None,
                 &self.size,
                 &self.tri_size,
                 l,
