@@ -4,8 +4,10 @@
 //! used by other than two triangles (a non-manifold edge, where three or more regions meet —
 //! a triple line, or shells touching along an edge), between two triangles with different side
 //! labels (the rim of an interface patch), or sharp: the interior dihedral angle between its two
-//! triangles below the feature angle. Feature edges are never split, collapsed or flipped, so
-//! the feature polylines, the triple lines and the interface rims stay exactly as given.
+//! triangles below the feature angle. Feature edges are never split, collapsed or flipped by the
+//! rounds (one longer than they would split is cut into kept pieces before them,
+//! [`super::presplit`]), so the feature polylines, the triple lines and the interface rims stay
+//! exactly as given.
 //!
 //! A point is *fixed* (never moved, never removed) when it lies on a feature edge or when its
 //! triangles do not form one fan (regions touching at a point). Every other point has a

@@ -356,6 +356,7 @@ pub fn improve_with_progress(
         Some(st) => {
             let f = Features {
                 fixed: st.fixed.clone(),
+                edges: st.edges.clone(),
                 ..f.clone()
             };
             remesh::Remesher::new(
