@@ -352,37 +352,30 @@ pub fn improve_with_progress(
         .collect();
     // Long edges cut to the target first: the rounds' midpoint splits would fan them out.
     let start = presplit::presplit(surface, &f, &samples, &point_size, l);
-    let mut r = match &start {
+    let cut_features;
+    let (s0, f0, cover, size0) = match &start {
         Some(st) => {
-            let f = Features {
+            cut_features = Features {
                 fixed: st.fixed.clone(),
                 edges: st.edges.clone(),
                 ..f.clone()
             };
-            remesh::Remesher::new(
-                &st.mesh,
-                &f,
-                &index,
-                &samples,
-                Some(&st.cover),
-                &st.point_size,
-                &tri_size,
-                l,
-                0.7 * d,
-            )
+            let cover = Some(st.cover.as_slice());
+            (&st.mesh, &cut_features, cover, st.point_size.as_slice())
         }
-        None => remesh::Remesher::new(
-            surface,
-            &f,
-            &index,
-            &samples,
-            None,
-            &point_size,
-            &tri_size,
-            l,
-            0.7 * d,
-        ),
+        None => (surface, &f, None, point_size.as_slice()),
     };
+    let mut r = remesh::Remesher::new(
+        s0,
+        f0,
+        &index,
+        &samples,
+        cover,
+        size0,
+        &tri_size,
+        l,
+        0.7 * d,
+    );
     // The loop keeps its samples within 0.7 D; the final measure then has room.
     r.spacing = (0.25 * l).max(d);
     r.target_angle = opts.target_angle_deg;

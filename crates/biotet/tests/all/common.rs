@@ -213,3 +213,17 @@ pub fn point_triangle_distance(p: [f64; 3], t: [[f64; 3]; 3]) -> f64 {
         })
         .fold(f64::INFINITY, f64::min)
 }
+
+/// A label image of `tests/data` through labels, extraction and validation as `biotet mesh
+/// IMAGE` does (its voxel surface and summary, before the surface stage).
+pub fn image_surface(name: &str) -> (SurfaceMesh, biotet::image::surface::ImageSummary) {
+    let path = format!("{}/../../tests/data/{name}", env!("CARGO_MANIFEST_DIR"));
+    let img = biotet_io::read_label_image(std::path::Path::new(&path)).expect("reads");
+    biotet::image::surface::labelled_surface(
+        img,
+        &biotet::image::labels::LabelOptions::default(),
+        &path,
+        &mut |_| {},
+    )
+    .expect("extracts")
+}

@@ -425,16 +425,9 @@ fn a_sheared_grid_is_meshed_in_a_frame_isometric_to_world() {
 /// is within 10°–165°.
 #[test]
 fn thick_slices_mesh_within_the_range() {
-    use biotet::image::surface::labelled_surface;
     use biotet::quality::tet::dihedral_angles;
     use biotet::surface::{SurfaceOptions, improve};
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../tests/data/ridge_aniso_crop.nii.gz"
-    );
-    let img = biotet_io::read_label_image(std::path::Path::new(path)).expect("reads");
-    let (voxels, summary) =
-        labelled_surface(img, &LabelOptions::default(), path, &mut |_| {}).expect("extracts");
+    let (voxels, summary) = crate::common::image_surface("ridge_aniso_crop.nii.gz");
     assert!(summary.orient_sheets());
     let opts = SurfaceOptions {
         tolerance: summary.default_surface_tolerance,

@@ -383,16 +383,8 @@ fn mesh_within_the_range(s: &SurfaceMesh) {
 /// cap, and its point may go in a second ring of neighbours: every tet within 10°–165°.
 #[test]
 fn polish_keeps_an_image_interface_ridge_within_the_range() {
-    use biotet::image::labels::LabelOptions;
-    use biotet::image::surface::labelled_surface;
     use biotet::surface::{SurfaceOptions, improve};
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../tests/data/mni_brain_ridge_40.nii.gz"
-    );
-    let img = biotet_io::read_label_image(std::path::Path::new(path)).expect("reads");
-    let (voxels, summary) =
-        labelled_surface(img, &LabelOptions::default(), path, &mut |_| {}).expect("extracts");
+    let (voxels, summary) = crate::common::image_surface("mni_brain_ridge_40.nii.gz");
     let opts = SurfaceOptions {
         tolerance: summary.default_surface_tolerance,
         ..Default::default()
