@@ -14,6 +14,8 @@
 
 use thiserror::Error;
 
+use crate::geom::vec3::det3;
+
 /// Why a [`ScalarGrid`] cannot be built from the given parts.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum GridError {
@@ -106,12 +108,6 @@ pub struct ScalarGrid {
     /// Inverse of `direction · diag(spacing)`: world offsets from `origin` to continuous grid
     /// indices.
     inv: [[f64; 3]; 3],
-}
-
-fn det3(m: &[[f64; 3]; 3]) -> f64 {
-    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
 }
 
 /// The inverse of `m` by cofactors, `None` when singular or not finite.

@@ -54,6 +54,15 @@ pub fn volume6(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> f64 {
     dot(sub(b, a), cross(sub(c, a), sub(d, a)))
 }
 
+/// The determinant of a 3×3 matrix given by rows (cofactor expansion along the first row). A
+/// measure only.
+#[inline]
+pub fn det3(m: &[[f64; 3]; 3]) -> f64 {
+    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+}
+
 /// The axis-aligned box `(lo, hi)` of any number of points; `lo` above `hi` (infinite) when
 /// there are none.
 pub fn points_bbox<'a>(pts: impl IntoIterator<Item = &'a [f64; 3]>) -> ([f64; 3], [f64; 3]) {

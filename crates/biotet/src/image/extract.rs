@@ -81,8 +81,7 @@ pub fn faces(img: &LabelImage) -> SurfaceMesh {
     };
     let flip = img.determinant() < 0.0;
     // Not a scaled permutation: the frame of a sheared grid ([`LabelImage::to_frame`]).
-    let m = &img.voxel_to_world;
-    let sheared = (0..3).any(|c| (0..3).filter(|&r| m[r][c] != 0.0).count() != 1);
+    let sheared = !img.is_scaled_permutation();
     let mut point_of: FxHashMap<usize, u32> = FxHashMap::default();
     let mut mesh = SurfaceMesh::default();
     let mut corner = |a: usize, b: usize, c: usize, mesh: &mut SurfaceMesh| -> u32 {

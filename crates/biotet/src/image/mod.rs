@@ -15,6 +15,8 @@
 //! - [`surface`]: both, on an image, with the summary the reports print (shared by the CLI and
 //!   the Python package).
 
+use crate::geom::vec3::det3;
+
 pub mod extract;
 pub mod labels;
 pub mod repair;
@@ -130,9 +132,14 @@ impl LabelImage {
     /// index axes are left-handed in world space).
     pub fn determinant(&self) -> f64 {
         let m = &self.voxel_to_world;
-        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+        det3(&std::array::from_fn(|r| [m[r][0], m[r][1], m[r][2]]))
+    }
+
+    /// Whether the voxel-to-world map is a scaled permutation (each voxel axis along a world
+    /// axis): no frame is needed ([`Self::to_frame`]).
+    pub fn is_scaled_permutation(&self) -> bool {
+        let m = &self.voxel_to_world;
+        (0..3).all(|c| (0..3).filter(|&r| m[r][c] != 0.0).count() == 1)
     }
 
     /// The volume of one voxel (world units cubed).
@@ -173,11 +180,10 @@ impl LabelImage {
     /// Axes count as orthogonal when every pair's cosine is under 1e-6: a map stored in single
     /// precision (NIfTI's) is orthogonal to about 1e-7.
     pub fn to_frame(&mut self) -> Option<[[f64; 4]; 4]> {
-        let m = self.voxel_to_world;
-        let aligned = (0..3).all(|c| (0..3).filter(|&r| m[r][c] != 0.0).count() == 1);
-        if aligned {
+        if self.is_scaled_permutation() {
             return None;
         }
+        let m = self.voxel_to_world;
         let s = self.spacing();
         let sign = if self.determinant() < 0.0 { -1.0 } else { 1.0 };
         let orthogonal = (0..3).all(|a| {
@@ -238,9 +244,7 @@ impl LabelImage {
 fn polar_rotation(a: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
     let mut x = a;
     for _ in 0..100 {
-        let det = x[0][0] * (x[1][1] * x[2][2] - x[1][2] * x[2][1])
-            - x[0][1] * (x[1][0] * x[2][2] - x[1][2] * x[2][0])
-            + x[0][2] * (x[1][0] * x[2][1] - x[1][1] * x[2][0]);
+        let det = det3(&x);
         // X⁻ᵀ is the cofactor matrix over the determinant.
         let cof = |r: usize, c: usize| {
             let (r1, r2) = ((r + 1) % 3, (r + 2) % 3);

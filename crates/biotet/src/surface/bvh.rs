@@ -251,7 +251,8 @@ pub fn dist2(a: P3, b: P3) -> f64 {
     dot(d, d)
 }
 
-fn box_d2(p: P3, lo: P3, hi: P3) -> f64 {
+/// The squared distance from `p` to the box `lo..hi` (0 inside).
+pub(super) fn box_d2(p: P3, lo: P3, hi: P3) -> f64 {
     let mut s = 0.0;
     for k in 0..3 {
         let e = if p[k] < lo[k] {

@@ -18,7 +18,7 @@
 use rayon::prelude::*;
 
 use super::bvh::{Bvh, Hint, PatchIndex, closest_on_triangle, dist2};
-use crate::geom::vec3::{cross, dot, sub};
+use crate::geom::vec3::{cross, norm, sub};
 
 type P3 = [f64; 3];
 
@@ -131,33 +131,26 @@ pub struct Sided {
 /// 500,000 of them, its pieces of about 3 × 0.4 some 17,000. Other triangles are one piece, as
 /// before.
 fn pieces(c: [P3; 3], spacing: f64) -> Vec<[P3; 3]> {
-    let longest2 = |t: &[P3; 3]| {
-        (0..3)
-            .map(|k| dist2(t[k], t[(k + 1) % 3]))
-            .fold(0.0, f64::max)
+    // The longest edge (the last of equals) and its squared length.
+    let longest = |t: &[P3; 3]| {
+        let e = [0, 1, 2].map(|k| dist2(t[k], t[(k + 1) % 3]));
+        let k = (0..3).fold(0, |m, i| if e[i] >= e[m] { i } else { m });
+        (k, e[k])
     };
-    let steps = |t: &[P3; 3]| longest2(t).sqrt() / spacing;
-    if steps(&c) <= GRID_STEPS as f64 {
+    if longest(&c).1.sqrt() / spacing <= GRID_STEPS as f64 {
         return vec![c];
     }
     let mut out = Vec::new();
     let mut stack = vec![c];
     while let Some(t) = stack.pop() {
-        let l2 = longest2(&t);
-        // Twice the area over the longest edge: the height onto it.
-        let area2 = {
-            let (u, v) = (sub(t[1], t[0]), sub(t[2], t[0]));
-            let n = cross(u, v);
-            dot(n, n).sqrt()
-        };
-        let fat = l2 <= PIECE_ASPECT * area2;
-        if (steps(&t) <= GRID_STEPS as f64 && fat) || steps(&t) <= 1.0 {
+        let (k, l2) = longest(&t);
+        let steps = l2.sqrt() / spacing;
+        // Twice the area over the longest edge is the height onto it.
+        let fat = l2 <= PIECE_ASPECT * norm(cross(sub(t[1], t[0]), sub(t[2], t[0])));
+        if (steps <= GRID_STEPS as f64 && fat) || steps <= 1.0 {
             out.push(t);
             continue;
         }
-        let k = (0..3)
-            .max_by(|&a, &b| dist2(t[a], t[(a + 1) % 3]).total_cmp(&dist2(t[b], t[(b + 1) % 3])))
-            .unwrap_or(0);
         let (a, b, c) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
         let m = [0, 1, 2].map(|x| 0.5 * (a[x] + b[x]));
         stack.push([m, b, c]);
