@@ -271,6 +271,17 @@ def cad_cylinder():
         return m.surface_mesh(size_max=0.2)
 
 
+def cad_tube_thin():
+    """A tube 3 long, radius 1, wall 0.03 (a cylinder minus a coaxial one) at gmsh's default sizes: two cylindrical
+    walls a thirtieth of the radius apart, each side triangle far longer than the wall is thick."""
+    with Gmsh("tube_thin") as m:
+        occ = m.g.model.occ
+        outer = occ.addCylinder(0, 0, 0, 0, 0, 3, 1.0)
+        inner = occ.addCylinder(0, 0, -0.1, 0, 0, 3.2, 0.97)
+        occ.cut([(3, outer)], [(3, inner)])
+        return m.surface_mesh()
+
+
 def cad_l_bracket():
     """L-bracket: an L profile (60 x 40, 6 thick) extruded 30, two holes in each leg and a chamfer-free inner corner:
     many planar facets, sharp convex and concave edges."""
@@ -503,6 +514,14 @@ def tm_box_random():
     return b.vertices, b.faces
 
 
+def tm_hull_random200():
+    """trimesh's convex hull of 200 uniform random points in the unit cube (numpy seed 200): 84 triangles of any shape,
+    needles and nearly flat folds, no symmetry."""
+    import trimesh
+    h = trimesh.convex.convex_hull(np.random.default_rng(200).random((200, 3)))
+    return h.vertices, h.faces
+
+
 def tm_capsule_turned():
     """trimesh's long thin capsule turned by a random rotation (numpy seed 3): its bounding box is many times its
     volume, and its pole triangles far smaller than the rest (the template's grid spacing follows the smallest size)."""
@@ -703,6 +722,8 @@ SHAPES = {
                            LICENCE["gmsh"], "the 13k part as a binary STL stores it: facets planar only to round-off"),
     "cad_component8_default": (cad_component8_default, "gmsh {gmsh} OCC, component8.step at default sizes",
                                LICENCE["gmsh"], "coarse CAD export: thin triangles, sharp edges"),
+    "cad_tube_thin": (cad_tube_thin, "gmsh {gmsh} OCC, cylinder minus coaxial cylinder, default sizes", "generated",
+                      "thin-walled tube: two cylinders a thirtieth of the radius apart"),
     "cad_as1_nut_default": (cad_as1_nut_default, "gmsh {gmsh} OCC, as1-tu-203.stp nut at default sizes",
                             LICENCE["gmsh"], "coarse CAD export of 380 triangles"),
     "cad_as1_plate_coarse": (cad_as1_plate_coarse, "gmsh {gmsh} OCC, as1-tu-203.stp plate, coarsest",
@@ -743,6 +764,14 @@ SHAPES = {
     "tm_hair_torus": (tm("torus", major_radius=1.0, minor_radius=0.001, major_sections=64, minor_sections=8),
                       "trimesh {trimesh} creation.torus(1, 0.001, 64, 8)", "generated",
                       "hair-thin ring (tube a thousandth of the ring): triangles 120 times longer than wide"),
+    "tm_square_torus": (tm("torus", major_radius=1.0, minor_radius=0.01, major_sections=200, minor_sections=4),
+                        "trimesh {trimesh} creation.torus(1, 0.01, 200, 4)", "generated",
+                        "square-section ring tube: planar isosceles-trapezoid faces (cocircular quads), 200 short segments"),
+    "tm_thin_annulus": (tm("annulus", r_min=1.0, r_max=1.01, height=1.0, sections=64),
+                        "trimesh {trimesh} creation.annulus(r_min=1, r_max=1.01, height=1, sections=64)", "generated",
+                        "ring wall a hundredth of its radius: every tet spans the wall"),
+    "tm_hull_random200": (tm_hull_random200, "trimesh {trimesh} convex_hull of 200 random points (seed 200)",
+                          "generated", "random convex hull: needles and nearly flat folds"),
     "tm_box_random": (tm_box_random, "trimesh {trimesh} creation.box, random extents and rotation (seed 1)", "generated",
                       "box faces folded by round-off along their diagonals"),
     "tm_icosphere": (tm("icosphere", subdivisions=3), "trimesh {trimesh} creation.icosphere(subdivisions=3)",

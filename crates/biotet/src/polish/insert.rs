@@ -108,19 +108,58 @@ impl Work {
         // domain thinner than the template's sealing zones (a thin tube) no interior node was
         // placed, t spans it from wall to wall, and only a point on its axis with every tet of
         // that cross-section refilled around it helps.
-        let ball = self.circumsphere_cavity(t, rp.max_tets)?;
-        if ball == faces || ball == edges || ball == ring {
+        let mut tried = vec![faces, edges, ring];
+        if let Some(ball) = circumcentre(&self.corners(t))
+            .and_then(|x| self.circumsphere_cavity(t, x, rp.max_tets))
+            .filter(|b| !tried.contains(b))
+        {
+            if let Some(ids) = self.insert_into(t, ball.clone(), thr, searcher, rp, sp, star, by) {
+                return Some(ids);
+            }
+            tried.push(ball);
+        }
+        // A cap (a flat tet on two boundary faces, as the Delaunay leaves on a planar quad of
+        // cocircular corners) has no useful circumcentre of its own: the balls of the tets
+        // inside it, each grown from the cap, are Delaunay refinement's cavities there (TetGen's
+        // `q` puts one point in each segment of a square-section ring tube).
+        if !self.is_cap(t) {
             return None;
         }
-        self.insert_into(t, ball, thr, searcher, rp, sp, star, by)
+        let inner: Vec<u32> = self.nb[t as usize]
+            .iter()
+            .copied()
+            .filter(|&n| n != NO_NEIGHBOR && self.labels[n as usize] == label)
+            .collect();
+        for n in inner {
+            let Some(ball) = circumcentre(&self.corners(n))
+                .and_then(|x| self.circumsphere_cavity(t, x, rp.max_tets))
+                .filter(|b| !tried.contains(b))
+            else {
+                continue;
+            };
+            if let Some(ids) = self.insert_into(t, ball.clone(), thr, searcher, rp, sp, star, by) {
+                return Some(ids);
+            }
+            tried.push(ball);
+        }
+        None
     }
 
-    /// The unforced tets of `t`'s label whose circumsphere strictly holds `t`'s circumcentre,
-    /// reached from `t` through faces (so never across a boundary or interface face), sorted; at
-    /// most `max` (else `None`). Floating point: it only chooses the cavity, whose use is decided
+    /// Whether `t` lies on two or more boundary or interface faces.
+    fn is_cap(&self, t: u32) -> bool {
+        let label = self.labels[t as usize];
+        self.nb[t as usize]
+            .iter()
+            .filter(|&&n| n == NO_NEIGHBOR || self.labels[n as usize] != label)
+            .count()
+            >= 2
+    }
+
+    /// The unforced tets of `t`'s label whose circumsphere strictly holds `x`, reached from `t`
+    /// through faces (so never across a boundary or interface face), `t` first, sorted; at most
+    /// `max` (else `None`). Floating point: it only chooses the cavity, whose use is decided
     /// exactly by [`Self::insert_into`].
-    fn circumsphere_cavity(&mut self, t: u32, max: usize) -> Option<Vec<u32>> {
-        let x = circumcentre(&self.corners(t))?;
+    fn circumsphere_cavity(&mut self, t: u32, x: P3, max: usize) -> Option<Vec<u32>> {
         let label = self.labels[t as usize];
         let mut out = vec![t];
         let mut seen: FxHashSet<u32> = FxHashSet::default();

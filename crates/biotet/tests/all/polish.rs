@@ -279,9 +279,10 @@ fn polish_refills_tets_above_165_degrees() {
 }
 
 /// trimesh's randomly turned box (tests/data/shapes/tm_box_random.off): the only fill of its
-/// eight corners, as the pipeline finds it, has a flat tet (0.00°). Polish's last pass replaces
-/// it by a point: from the tet's edge cavity, a cone with four tets at 9.8°; over the whole box
-/// (two rings of face neighbours), every tet at 11.9°.
+/// eight corners, as the pipeline finds it, has a flat tet (0.00°), a cap on two surface
+/// triangles. From the tet's edge cavity a point gives a cone with four tets at 9.8°; from the
+/// ball of a tet inside the cap (a cap's last cavity), every tet is at 11.9° or more, in the
+/// first pass (polish's last pass found the same over two rings of face neighbours before).
 #[test]
 fn polish_rescues_a_flat_tet_of_a_thin_box_with_every_tet_above_the_threshold() {
     let s = crate::common::load_shape("tm_box_random.off");
@@ -298,13 +299,16 @@ fn polish_rescues_a_flat_tet_of_a_thin_box_with_every_tet_above_the_threshold() 
     let mut m = TetMesh::new(s.points.clone(), tets, vec![1; 7]);
     assert!((0..7).any(|t| min_deg(&m, t) < 0.01), "the flat tet");
     let r = polish(&mut m, &PolishOptions::default());
-    assert_eq!(r.flat_rescued, 1, "{r:?}");
+    assert_eq!(r.inserts_accepted, 1, "{r:?}");
     assert_eq!(r.n_bad_after, 0, "{r:?}");
     assert_eq!(m.points.len(), 9);
     assert_all_positive(&m);
     let c = check(&m, Some(&s));
     assert!(c.valid, "{c}");
-    assert!((0..m.tets.len()).all(|t| min_deg(&m, t) >= 11.9));
+    let worst = (0..m.tets.len())
+        .map(|t| min_deg(&m, t))
+        .fold(f64::INFINITY, f64::min);
+    assert!(worst >= 11.9, "{worst}");
 }
 
 /// gmsh's tutorial STL t13 (tests/data/shapes/pkg_gmsh_t13.off), meshed as `biotet mesh` does by
@@ -333,6 +337,40 @@ fn polish_rescues_the_flattest_tet_of_a_cad_stl() {
         .map(|t| min_deg(&m, t))
         .fold(f64::INFINITY, f64::min);
     assert!(worst > 1e-4, "smallest dihedral angle {worst}°");
+    assert_all_positive(&m);
+    let c = check(&m, Some(&s));
+    assert!(c.valid, "{c}");
+}
+
+/// trimesh's square-section ring tube (tests/data/shapes/tm_square_torus.off: 200 segments 0.031
+/// long and 0.014 across, every side face a planar isosceles trapezoid, so its four corners are
+/// cocircular): the Delaunay leaves a flat cap (3e-14°) on many of those faces, inside, two of
+/// its faces on the surface; no interior node fits the tube and no refill without a point removes
+/// a cap. TetGen `pq1.2Y` puts one point in each segment and keeps none under 10°. Polish now
+/// tries, for a cap, the balls of the tets inside it and trades the cap at once for tets above
+/// half the threshold: it leaves 146 of the 332 tets under 10° that it is given (the build before,
+/// 227).
+#[test]
+fn polish_at_least_halves_the_tets_under_10_degrees_of_a_square_section_ring_tube() {
+    use biotet::mesh::validate::{ValidateOptions, validate_surface};
+    use biotet::pipeline::{PipelineOptions, mesh_surface};
+    let mut s = crate::common::load_shape("tm_square_torus.off");
+    validate_surface(&mut s, &ValidateOptions::default()).unwrap();
+    let sizing = crate::common::default_sizing(&s);
+    let bad = |m: &TetMesh| (0..m.tets.len()).filter(|&t| min_deg(m, t) < 10.0).count();
+    let no_polish = PipelineOptions {
+        polish: None,
+        ..PipelineOptions::default()
+    };
+    let (before, _) = mesh_surface(&s, &sizing, &no_polish, &mut |_| {}).unwrap();
+    let (m, report) = mesh_surface(&s, &sizing, &PipelineOptions::default(), &mut |_| {}).unwrap();
+    let (b, a) = (bad(&before), bad(&m));
+    assert!(b > 200, "{b} tets under 10° before polish");
+    assert!(
+        2 * a <= b,
+        "{a} of {b} tets under 10° left: {:?}",
+        report.polish
+    );
     assert_all_positive(&m);
     let c = check(&m, Some(&s));
     assert!(c.valid, "{c}");
