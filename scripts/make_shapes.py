@@ -875,7 +875,8 @@ def write_readme(path, rows, rejected, ver):
         "",
         "Closed triangle surfaces for issue 19 (every valid closed surface meshes). Regenerate them all with",
         "`python3 scripts/make_shapes.py` (deterministic for the versions below); benchmark them beside TetGen with",
-        "`python3 scripts/bench_shapes.py`. Every file is OFF, coordinates written with Python's `repr` (read back as",
+        "`python3 scripts/bench_shapes.py`; mesh each at several sizes, turned and scaled, with",
+        "`python3 scripts/sweep_shapes.py`. Every file is OFF, coordinates written with Python's `repr` (read back as",
         "the same doubles), exactly equal points welded, and accepted by `biotet validate` when it was made.",
         f"Made with gmsh {ver['gmsh']}, trimesh {ver['trimesh']}, pyvista {ver['pyvista']} (wheel), "
         f"pymeshlab {ver['pymeshlab']} (wheel).",

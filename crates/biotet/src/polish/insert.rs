@@ -2,8 +2,10 @@
 //!
 //! The cavity is the tet and its unforced face neighbours of the same label, or, when that fails,
 //! every unforced tet of its label sharing an edge with it, or else the face cavity with its
-//! unforced face neighbours of the label (a cavity with an interior point is not tried). A
-//! nearly flat tet's last chance (polish's rescue pass) starts from two rings of face neighbours.
+//! unforced face neighbours of the label (a cavity with an interior point is not tried), or else
+//! Delaunay refinement's cavity for its circumcentre, and for a tet on two walls those of the
+//! tets inside it. A nearly flat tet's last chance (polish's rescue pass) starts from two rings
+//! of face neighbours.
 //! Boundary and interface faces are never crossed, so they stay on the cavity's shell.
 //! The candidates are the tet's centroid and circumcentre, the centroids of the cavity's tets, the
 //! midpoints between the tet's centroid and theirs, the shell's vertex centroid, and points pushed
@@ -55,18 +57,20 @@ impl Work {
         let label = self.labels[t as usize];
         let faces = self.with_face_neighbours(t);
         let by = Judge::MinAngle;
-        // A nearly flat tet's last chance (rare: one on wm_20k) starts from two rings of face
-        // neighbours: the more room around the new point, the fewer of its tets below the
-        // threshold. A randomly turned box whose only fill of its corners has a flat tet got,
-        // from the tet's edge cavity, a cone with four tets at 9.8°; coned over the whole box,
-        // every tet is above 11.9°.
+        // A nearly flat tet's last chance starts from two rings of face neighbours: the more room
+        // around the new point, the fewer of its tets below the threshold (brain_20k rescues two
+        // tets so, wm_20k one, the square-section ring tube ten).
+        let mut tried = Vec::new();
         if self.rescue >= Rescue::Flat {
             let ring = self.face_ring(&faces, label);
             let wide = self.face_ring(&ring, label);
-            if wide != faces
-                && let Some(ids) = self.insert_into(t, wide, thr, searcher, rp, sp, star, by)
-            {
-                return Some(ids);
+            if wide != faces {
+                if let Some(ids) =
+                    self.insert_into(t, wide.clone(), thr, searcher, rp, sp, star, by)
+                {
+                    return Some(ids);
+                }
+                tried.push(wide);
             }
         }
         if let Some(ids) = self.insert_into(t, faces.clone(), thr, searcher, rp, sp, star, by) {
@@ -107,31 +111,22 @@ impl Work {
         // The tets whose circumspheres hold t's circumcentre (Delaunay refinement's cavity): in a
         // domain thinner than the template's sealing zones (a thin tube) no interior node was
         // placed, t spans it from wall to wall, and only a point on its axis with every tet of
-        // that cross-section refilled around it helps.
-        let mut tried = vec![faces, edges, ring];
-        if let Some(ball) = circumcentre(&self.corners(t))
-            .and_then(|x| self.circumsphere_cavity(t, x, rp.max_tets))
-            .filter(|b| !tried.contains(b))
-        {
-            if let Some(ids) = self.insert_into(t, ball.clone(), thr, searcher, rp, sp, star, by) {
-                return Some(ids);
+        // that cross-section refilled around it helps. A tet on two walls (a cap: the flat tet the
+        // Delaunay leaves on a planar quad of cocircular corners) has no useful circumcentre of its
+        // own: the balls of the unforced tets inside it, each grown from it, are Delaunay
+        // refinement's cavities there (TetGen's `q` puts one point in each segment of a
+        // square-section ring tube).
+        tried.extend([faces, edges, ring]);
+        let mut seeds = vec![t];
+        if self.on_two_walls(t) {
+            for n in self.nb[t as usize] {
+                if n != NO_NEIGHBOR && self.labels[n as usize] == label && !self.is_forced(n) {
+                    seeds.push(n);
+                }
             }
-            tried.push(ball);
         }
-        // A cap (a flat tet on two boundary faces, as the Delaunay leaves on a planar quad of
-        // cocircular corners) has no useful circumcentre of its own: the balls of the tets
-        // inside it, each grown from the cap, are Delaunay refinement's cavities there (TetGen's
-        // `q` puts one point in each segment of a square-section ring tube).
-        if !self.is_cap(t) {
-            return None;
-        }
-        let inner: Vec<u32> = self.nb[t as usize]
-            .iter()
-            .copied()
-            .filter(|&n| n != NO_NEIGHBOR && self.labels[n as usize] == label)
-            .collect();
-        for n in inner {
-            let Some(ball) = circumcentre(&self.corners(n))
+        for s in seeds {
+            let Some(ball) = circumcentre(&self.corners(s))
                 .and_then(|x| self.circumsphere_cavity(t, x, rp.max_tets))
                 .filter(|b| !tried.contains(b))
             else {
@@ -145,8 +140,8 @@ impl Work {
         None
     }
 
-    /// Whether `t` lies on two or more boundary or interface faces.
-    fn is_cap(&self, t: u32) -> bool {
+    /// Whether `t` lies on two or more boundary or interface faces (its shape is not looked at).
+    fn on_two_walls(&self, t: u32) -> bool {
         let label = self.labels[t as usize];
         self.nb[t as usize]
             .iter()
@@ -155,9 +150,9 @@ impl Work {
             >= 2
     }
 
-    /// The unforced tets of `t`'s label whose circumsphere strictly holds `x`, reached from `t`
-    /// through faces (so never across a boundary or interface face), `t` first, sorted; at most
-    /// `max` (else `None`). Floating point: it only chooses the cavity, whose use is decided
+    /// `t` and the unforced tets of its label whose circumsphere strictly holds `x`, reached from
+    /// `t` through faces (so never across a boundary or interface face), sorted; at most `max`
+    /// (else `None`). Floating point: it only chooses the cavity, whose use is decided
     /// exactly by [`Self::insert_into`].
     fn circumsphere_cavity(&mut self, t: u32, x: P3, max: usize) -> Option<Vec<u32>> {
         let label = self.labels[t as usize];
