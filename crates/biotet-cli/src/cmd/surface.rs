@@ -63,8 +63,8 @@ enum Sub {
 /// Options of the stage, shared with `biotet mesh`.
 #[derive(clap::Args, Clone, Debug)]
 pub struct StageArgs {
-    /// Edges whose dihedral angle is below this (degrees) are kept as features (polylines and
-    /// corners stay exactly); 0: none for its angle alone.
+    /// Edges whose dihedral angle is below this (degrees, 0–180) are kept as features
+    /// (polylines and corners stay exactly); 0: none for its angle alone.
     #[arg(long, value_name = "DEG", default_value_t = 30.0)]
     pub feature_angle: f64,
     /// Curvature-adapted edge lengths (shorter where the surface bends, down to half the edge

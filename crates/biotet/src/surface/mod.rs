@@ -197,9 +197,11 @@ pub enum SurfaceError {
     Output(validate::SurfaceError),
     /// The distance bound could not be kept.
     #[error(
-        "surface stage: cannot keep the surface within {tolerance}: measured {in_to_out} from \
-         input to output and {out_to_in} from output to input (try a larger tolerance or a \
-         smaller edge length)"
+        "surface stage: cannot keep the surface within {}: measured {} from input to output and \
+         {} from output to input (try a larger tolerance or a smaller edge length)",
+        short(.tolerance),
+        short(.in_to_out),
+        short(.out_to_in)
     )]
     Tolerance {
         /// `D`.
@@ -209,6 +211,13 @@ pub enum SurfaceError {
         /// Measured output → input.
         out_to_in: f64,
     },
+}
+
+/// `x` as Rust writes it, or in scientific notation where that is long (a tolerance of 1e-300
+/// came out as 300 zeros).
+fn short(x: &f64) -> String {
+    let s = format!("{x}");
+    if s.len() > 20 { format!("{x:.4e}") } else { s }
 }
 
 /// The median edge length of a surface.
@@ -309,6 +318,12 @@ pub fn improve_with_progress(
     if !(d.is_finite() && d > 0.0) {
         return Err(SurfaceError::Options(format!(
             "the tolerance must be positive, got {d}"
+        )));
+    }
+    let a = opts.feature_angle_deg;
+    if !(0.0..=180.0).contains(&a) {
+        return Err(SurfaceError::Options(format!(
+            "the feature angle must be between 0 and 180 degrees, got {a}"
         )));
     }
     let mut input = surface.clone();

@@ -293,3 +293,33 @@ fn a_flat_fold_is_opened_within_the_tolerance() {
     let mut check = out.clone();
     validate_surface(&mut check, &ValidateOptions::default()).expect("valid output");
 }
+
+/// A feature angle outside 0–180° (or NaN) is refused, naming it; a tolerance that cannot be kept
+/// is named in a short form however small it is (1e-300 came out as 300 zeros).
+#[test]
+fn bad_options_are_refused_in_a_line_a_user_can_read() {
+    let s = uv_sphere(1.0, [0.0; 3], 12, 6);
+    for a in [-5.0, 1000.0, f64::NAN] {
+        let opts = SurfaceOptions {
+            tolerance: 0.05,
+            feature_angle_deg: a,
+            ..SurfaceOptions::default()
+        };
+        let e = improve(&s, &opts).unwrap_err();
+        assert!(
+            matches!(&e, SurfaceError::Options(m) if m.contains("feature angle")),
+            "{a}: {e}"
+        );
+    }
+    let e = SurfaceError::Tolerance {
+        tolerance: 1e-300,
+        in_to_out: 0.25,
+        out_to_in: 3.0e-17,
+    }
+    .to_string();
+    assert!(e.len() < 200, "{e}");
+    assert!(
+        e.contains("within 1.0000e-300:") && e.contains("measured 0.25 from"),
+        "{e}"
+    );
+}
