@@ -120,7 +120,7 @@ impl Work {
         let mut seeds = vec![t];
         if self.on_two_walls(t) {
             for n in self.nb[t as usize] {
-                if n != NO_NEIGHBOR && self.labels[n as usize] == label && !self.is_forced(n) {
+                if !self.outside(label, n) && !self.is_forced(n) {
                     seeds.push(n);
                 }
             }
@@ -145,7 +145,7 @@ impl Work {
         let label = self.labels[t as usize];
         self.nb[t as usize]
             .iter()
-            .filter(|&&n| n == NO_NEIGHBOR || self.labels[n as usize] != label)
+            .filter(|&&n| self.outside(label, n))
             .count()
             >= 2
     }
@@ -164,7 +164,7 @@ impl Work {
             let s = out[i];
             i += 1;
             for n in self.nb[s as usize] {
-                if n == NO_NEIGHBOR || !seen.insert(n) || self.labels[n as usize] != label {
+                if self.outside(label, n) || !seen.insert(n) {
                     continue;
                 }
                 let c = self.corners(n);

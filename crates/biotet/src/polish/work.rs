@@ -75,7 +75,7 @@ impl Work {
         for t in 0..n {
             for (i, f) in TET_FACES.iter().enumerate() {
                 let o = w.nb[t][i];
-                if o == NO_NEIGHBOR || w.labels[o as usize] != w.labels[t] {
+                if w.outside(w.labels[t], o) {
                     for &k in f {
                         w.fixed[w.tets[t][k] as usize] = true;
                     }
@@ -147,6 +147,12 @@ impl Work {
         min_deg(&self.corners(t))
     }
 
+    /// Whether neighbour `n` (a tet id or [`NO_NEIGHBOR`]) lies outside the region `label`: the
+    /// face between is a boundary or interface face, a wall.
+    pub fn outside(&self, label: u32, n: u32) -> bool {
+        n == NO_NEIGHBOR || self.labels[n as usize] != label
+    }
+
     /// Tet `t` and its unforced face neighbours of its label, sorted.
     pub fn with_face_neighbours(&mut self, t: u32) -> Vec<u32> {
         let label = self.labels[t as usize];
@@ -158,7 +164,7 @@ impl Work {
         let mut out = tets.to_vec();
         for &s in tets {
             for n in self.nb[s as usize] {
-                if n != NO_NEIGHBOR && self.labels[n as usize] == label && !self.is_forced(n) {
+                if !self.outside(label, n) && !self.is_forced(n) {
                     out.push(n);
                 }
             }
@@ -221,7 +227,7 @@ impl Work {
         let lim = self.forced_deg;
         for (i, l) in TET_FACES.iter().enumerate() {
             let n = self.nb[t as usize][i];
-            if (n == NO_NEIGHBOR || self.labels[n as usize] != label)
+            if self.outside(label, n)
                 && min_angle_3d_deg(&l.map(|k| self.pts[tv[k] as usize])) < lim
             {
                 return true;
@@ -264,7 +270,7 @@ impl Work {
             let (mut prev, mut s) = (t, self.nb[t as usize][i]);
             let mut steps = 0;
             loop {
-                if s == NO_NEIGHBOR || self.labels[s as usize] != label {
+                if self.outside(label, s) {
                     open = true;
                     break;
                 }

@@ -21,7 +21,7 @@
 //! 10° (1.52°); cut, 27° and none. Inputs without such edges (the brain surfaces, images of
 //! cubic voxels, the shape corpus at 1% of its diagonal) start from themselves as before.
 
-use rustc_hash::FxHashMap;
+use rustc_hash::{FxHashMap, FxHashSet};
 
 use super::bvh::{box_d2, closest_on_triangle, dist2};
 use super::features::{Features, key};
@@ -48,7 +48,7 @@ pub struct Start {
     /// The features' fixed points, extended to the new points (free, but on a cut kept edge).
     pub fixed: Vec<bool>,
     /// The kept edges, a cut one replaced by its pieces.
-    pub edges: rustc_hash::FxHashSet<(u32, u32)>,
+    pub edges: FxHashSet<(u32, u32)>,
     /// The point sizes extended (a cut point: the smaller of its edge's ends).
     pub point_size: Vec<f64>,
     /// Per input sample: the triangle of `mesh` that covers it (the piece nearest to it) and
