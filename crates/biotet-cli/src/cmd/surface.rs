@@ -140,11 +140,20 @@ pub fn stage(
     })?)
 }
 
+/// A distance with four decimals, or four significant digits when that would print zeros.
+fn length(x: f64) -> String {
+    if x == 0.0 || x.abs() >= 1e-3 {
+        format!("{x:.4}")
+    } else {
+        format!("{x:.3e}")
+    }
+}
+
 /// The report as text lines.
 pub fn report_text(r: &SurfaceReport) -> String {
     let mut t = format!(
         "surface: {} → {} triangles in {:.3} s (edge length {:.4}, tolerance {})\n\
-         \x20 Hausdorff input→output {:.4}, output→input {:.4} (bound {:.4}, {} samples)\n\
+         \x20 Hausdorff input→output {}, output→input {} (bound {}, {} samples)\n\
          \x20 triangle angles: min {:.2}° → {:.2}°, max {:.2}° → {:.2}°; under {}°: {} → {} \
          ({} at kept features)\n\
          \x20 folds (dihedral angle inside at an edge): min {:.2}° → {:.2}° ({} points moved to \
@@ -154,9 +163,9 @@ pub fn report_text(r: &SurfaceReport) -> String {
         r.seconds,
         r.edge_length,
         r.tolerance,
-        r.hausdorff_in_to_out,
-        r.hausdorff_out_to_in,
-        r.hausdorff_bound,
+        length(r.hausdorff_in_to_out),
+        length(r.hausdorff_out_to_in),
+        length(r.hausdorff_bound),
         r.n_samples,
         r.min_angle_in,
         r.min_angle_out,
@@ -170,6 +179,13 @@ pub fn report_text(r: &SurfaceReport) -> String {
         r.min_fold_out,
         r.n_fold_moves,
     );
+    if r.hausdorff_bound > r.tolerance {
+        t += &format!(
+            "  note: every sample is within the tolerance, but the distance is proven only to \
+             within {} (too small a tolerance for the samples to prove on this surface)\n",
+            length(r.hausdorff_bound)
+        );
+    }
     for v in &r.regions {
         t += &format!(
             "  region {}: volume {:.4} → {:.4} ({:+.3}%)\n",

@@ -432,7 +432,13 @@ pub fn improve_with_progress(
     // The input samples found beyond D by the last measure.
     let mut far_before: FxHashSet<[u64; 3]> = FxHashSet::default();
     let mut seconds_measure = 0.0;
-    let (out, oi, io) = loop {
+    // The best output measured so far: none with a sample beyond D first, then the fewest
+    // triangles beyond D or unproven. Once the best has no sample beyond D, a repair round that
+    // does not improve on it ends the repairs (at a tolerance too small for the samples to
+    // prove, a millionth of the model's size, each round split more triangles and proved
+    // none), and the best is kept.
+    let mut best: Option<((bool, usize), Measured)> = None;
+    let (out, oi, io, repair_rounds) = loop {
         progress("validating");
         let mut out = r.to_surface();
         validate_surface(
@@ -450,19 +456,24 @@ pub fn improve_with_progress(
         }
         // Beyond: a sample over D, or a bound the finest samples cannot bring under it.
         let beyond = oi.bound.max(io.bound) > d;
-        if !beyond || repair_rounds == REPAIRS {
-            break (out, oi, io);
-        }
+        let key = (oi.max.max(io.max) > d, oi.far.len() + io.far.len());
+        let stuck = best.as_ref().is_some_and(|b| b.0 <= key && !b.0.0);
         // `out` lists the alive triangles of `r` in order.
         let ids: Vec<u32> = (0..r.tris.len() as u32)
             .filter(|&t| r.alive[t as usize])
             .collect();
-        if ids.len() != out.triangles.len() {
-            break (out, oi, io);
+        let last = stuck || !beyond || repair_rounds == REPAIRS || ids.len() != out.triangles.len();
+        if !last {
+            progress("repair");
+            refine_where_far(&mut r, &oi, &io, &far_before, |t| ids[t as usize]);
+            far_before = io.far.iter().map(|x| x.point.map(f64::to_bits)).collect();
         }
-        progress("repair");
-        refine_where_far(&mut r, &oi, &io, &far_before, |t| ids[t as usize]);
-        far_before = io.far.iter().map(|x| x.point.map(f64::to_bits)).collect();
+        if best.as_ref().is_none_or(|b| key < b.0) {
+            best = Some((key, (out, oi, io, repair_rounds)));
+        }
+        if last {
+            break best.take().map(|b| b.1).expect("a measured output");
+        }
         // The splits and projections may fold the surface again.
         folds_opened += r.open_folds();
         repair_rounds += 1;
@@ -555,6 +566,10 @@ pub fn improve_with_progress(
     Ok((out, report))
 }
 
+/// A measured output: the surface, its distances output → input and input → output, and the
+/// repair rounds that made it.
+type Measured = (SurfaceMesh, hausdorff::Sided, hausdorff::Sided, usize);
+
 /// How [`both_ways`] samples (see [`hausdorff::one_sided`]).
 struct Sampling {
     spacing: f64,
@@ -643,8 +658,8 @@ fn refine_where_far(
 const REPAIRS: usize = 4;
 
 /// The final measure of `out` against the input `surface` (both ways, dense samples, every
-/// triangle's bound refined until it proves the tolerance `d` or the samples reach a 32nd of
-/// `spacing`); samples beyond `d` are listed as far.
+/// cell that cannot prove the tolerance `d` sampled finer until it does or its samples are a
+/// thousandth of `spacing` apart); samples beyond `d` are listed as far.
 fn final_measure(
     surface: &SurfaceMesh,
     out: &SurfaceMesh,
@@ -661,7 +676,7 @@ fn final_measure(
             &out_index,
             Sampling {
                 spacing,
-                fine: spacing / 32.0,
+                fine: spacing / 1024.0,
                 limit: d,
                 flag: d,
                 floor,
