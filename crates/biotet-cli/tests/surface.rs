@@ -77,6 +77,8 @@ fn surface_improve_keeps_the_tolerance_and_raises_the_angles() {
         "hausdorff_in_to_out",
         "hausdorff_out_to_in",
         "hausdorff_bound",
+        "hausdorff_bound_in_to_out",
+        "hausdorff_bound_out_to_in",
         "regions",
         "min_angle_in",
         "min_angle_out",

@@ -153,7 +153,7 @@ fn length(x: f64) -> String {
 pub fn report_text(r: &SurfaceReport) -> String {
     let mut t = format!(
         "surface: {} → {} triangles in {:.3} s (edge length {:.4}, tolerance {})\n\
-         \x20 Hausdorff input→output {}, output→input {} (bound {}, {} samples)\n\
+         \x20 Hausdorff input→output {} (bound {}), output→input {} (bound {}); {} samples\n\
          \x20 triangle angles: min {:.2}° → {:.2}°, max {:.2}° → {:.2}°; under {}°: {} → {} \
          ({} at kept features)\n\
          \x20 folds (dihedral angle inside at an edge): min {:.2}° → {:.2}° ({} points moved to \
@@ -164,8 +164,9 @@ pub fn report_text(r: &SurfaceReport) -> String {
         r.edge_length,
         r.tolerance,
         length(r.hausdorff_in_to_out),
+        length(r.hausdorff_bound_in_to_out),
         length(r.hausdorff_out_to_in),
-        length(r.hausdorff_bound),
+        length(r.hausdorff_bound_out_to_in),
         r.n_samples,
         r.min_angle_in,
         r.min_angle_out,

@@ -59,9 +59,10 @@ pub struct SurfaceOptions {
     /// docs/method.md: on the marching-cubes test surfaces it doubles the triangles and the
     /// repair of the distance bound does not yet always converge).
     pub adaptive: bool,
-    /// Sample spacing of the final measure; default `tolerance` (at least a 32nd of the edge
-    /// length), down to a 32nd of that on the triangles whose bound it does not prove within
-    /// the tolerance (a maximum 0.487 D from D needs a step under D/40 to prove it).
+    /// Sample spacing of the final measure; default `tolerance`, but at most a quarter of the
+    /// edge length (so an output triangle has samples inside it, not only its corners, which lie
+    /// on the input) and at least a 32nd of it; finer on the cells whose bound it does not
+    /// prove within the tolerance (see [`hausdorff::one_sided`]).
     pub sample_spacing: Option<f64>,
     /// Turn each sheet one way first (`orient_sheets`), so edges where a sheet's triangles change
     /// orientation are not kept as interface rims. Default `true`; a label image of cubic voxels
@@ -129,6 +130,12 @@ pub struct SurfaceReport {
     /// per grid cell its corners' largest distance to one triangle, the distance to a triangle
     /// being convex: [`hausdorff::Sided::bound`]).
     pub hausdorff_bound: f64,
+    /// A proven upper bound on the true distance from the input to the output (as
+    /// `hausdorff_bound`, this direction alone): the sampled maximum can be far below it where
+    /// the input's triangles are smaller than the sample spacing.
+    pub hausdorff_bound_in_to_out: f64,
+    /// A proven upper bound on the true distance from the output to the input.
+    pub hausdorff_bound_out_to_in: f64,
     /// Spacing of the samples of the final measure.
     pub sample_spacing: f64,
     /// Samples measured (both ways).
@@ -350,7 +357,7 @@ pub fn improve_with_progress(
         None => median_edge_length(surface),
     };
     // At most about 32 samples along an edge of length L (a tiny D would ask for millions).
-    let spacing = opts.sample_spacing.unwrap_or(d.max(l / 32.0));
+    let spacing = opts.sample_spacing.unwrap_or(d.min(0.25 * l).max(l / 32.0));
     let f = features::find(surface, opts.feature_angle_deg);
     let index = PatchIndex::new(&surface.points, &surface.triangles, &surface.sides, None);
     // Input samples for the in→out guard, spaced D (at least a quarter edge length).
@@ -537,6 +544,8 @@ pub fn improve_with_progress(
         hausdorff_in_to_out: io.max,
         hausdorff_out_to_in: oi.max,
         hausdorff_bound: io.bound.max(oi.bound),
+        hausdorff_bound_in_to_out: io.bound,
+        hausdorff_bound_out_to_in: oi.bound,
         sample_spacing: spacing,
         n_samples: io.n_samples + oi.n_samples,
         sheets,

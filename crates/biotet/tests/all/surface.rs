@@ -271,8 +271,13 @@ fn a_tiny_tolerance_keeps_a_cad_surface_as_it_came() {
         )
         .expect("improves");
         assert!(report.hausdorff_in_to_out <= d && report.hausdorff_out_to_in <= d);
-        assert!(
-            report.hausdorff_bound >= report.hausdorff_in_to_out.max(report.hausdorff_out_to_in)
+        assert!(report.hausdorff_bound_in_to_out >= report.hausdorff_in_to_out);
+        assert!(report.hausdorff_bound_out_to_in >= report.hausdorff_out_to_in);
+        assert_eq!(
+            report.hausdorff_bound,
+            report
+                .hausdorff_bound_in_to_out
+                .max(report.hausdorff_bound_out_to_in)
         );
         if d == 0.003 {
             assert!(report.hausdorff_bound <= d, "{}", report.hausdorff_bound);
