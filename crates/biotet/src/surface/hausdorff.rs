@@ -10,7 +10,9 @@
 //! largest distance of its three corners to one triangle of the other surface (one found at a
 //! corner): the distance to one triangle is convex, so over the cell it is largest at a corner,
 //! and the cell is proven without finer samples (on the brain models, a third of the samples).
-//! The larger of the two per cell, over all cells, is [`Sided::bound`].
+//! A cell neither proves is sampled finer on its own, recursively ([`Probe::cell`]), so the
+//! samples gather where the distance comes near the limit. The largest bound over all cells is
+//! [`Sided::bound`].
 //!
 //! Parallel over triangles; the maximum does not depend on the order, so the result is the same
 //! on any number of threads.
@@ -127,13 +129,7 @@ impl Probe<'_> {
         budget: &mut usize,
     ) -> f64 {
         // Every cell is `c` scaled by 1/n: the Lipschitz bound needs no corner points.
-        let h = covering(
-            (0..3)
-                .map(|k| dist2(c[k], c[(k + 1) % 3]))
-                .fold(0.0, f64::max)
-                .sqrt()
-                / n as f64,
-        );
+        let h = covering(longest_edge(c) / n as f64);
         let mut worst = 0.0f64;
         for i in 0..n {
             for j in 0..n - i {
@@ -179,10 +175,7 @@ impl Probe<'_> {
         fine: f64,
         budget: &mut usize,
     ) -> f64 {
-        let longest = (0..3)
-            .map(|k| dist2(p[k], p[(k + 1) % 3]))
-            .fold(0.0, f64::max)
-            .sqrt();
+        let longest = longest_edge(&p);
         let top = r.iter().map(|x| x.0).fold(0.0, f64::max);
         let lip = top + covering(longest);
         if lip <= limit {
@@ -222,6 +215,14 @@ impl Probe<'_> {
     }
 }
 
+/// The length of the longest edge of `c`.
+fn longest_edge(c: &[P3; 3]) -> f64 {
+    (0..3)
+        .map(|k| dist2(c[k], c[(k + 1) % 3]))
+        .fold(0.0, f64::max)
+        .sqrt()
+}
+
 /// The place of grid point `(i, j)` of an `n`-step grid, row by row (row `i` holds `n + 1 - i`
 /// points).
 fn grid_index(n: usize, i: usize, j: usize) -> usize {
@@ -250,7 +251,8 @@ pub struct Sided {
     /// The largest sampled distance.
     pub max: f64,
     /// An upper bound on the true distance: per grid cell, `max` plus the samples' covering
-    /// radius, or where that is over the limit, the cell's corners' distance to one triangle.
+    /// radius, or where that is over the limit, the cell's corners' distance to one triangle,
+    /// or the bound of its finer cells.
     pub bound: f64,
     /// Per side-label pair, the largest sampled distance.
     pub per_sheet: Vec<([u32; 2], f64)>,
@@ -369,10 +371,7 @@ pub fn one_sided(
             };
             let mut bound_all = 0.0f64;
             for c in pieces(c, spacing) {
-                let longest = (0..3)
-                    .map(|k| dist2(c[k], c[(k + 1) % 3]))
-                    .fold(0.0, f64::max)
-                    .sqrt();
+                let longest = longest_edge(&c);
                 let base = ((longest / spacing).ceil() as usize).max(1);
                 let mut n = base;
                 // Where the grid cannot prove the limit and a grid fine enough for its
