@@ -239,7 +239,8 @@ fn mesh_with(
         image,
     } = input;
     // Image labels are the image's values; the template holds small labels.
-    let compaction = image.as_ref().map(|_| Compaction::of_surface(&mut surface));
+    let compaction = (image.is_some() || Compaction::needed(&surface))
+        .then(|| Compaction::of_surface(&mut surface));
     let frame_to_world = image.as_ref().and_then(|i| i.frame_to_world);
     // The surface stage (as `biotet mesh --surface-tolerance D`; an image's default).
     let tolerance = match &image {
@@ -259,8 +260,18 @@ fn mesh_with(
                 orient_sheets: image.as_ref().is_none_or(|i| i.orient_sheets()),
                 ..Default::default()
             };
-            let (s, r) = biotet::surface::improve(&surface, &so)
-                .map_err(|e| Failure::new(Kind::Meshing, format!("{name}: surface stage: {e}")))?;
+            // Each step a progress point, so Ctrl-C stops the stage within a round.
+            let (s, r) = biotet::surface::improve_with_progress(&surface, &so, &|step| {
+                progress(&format!("improving the surface: {step}"))
+            })
+            .map_err(|e| {
+                // A bad option is the caller's value; the error names the stage itself.
+                let kind = match e {
+                    biotet::surface::SurfaceError::Options(_) => Kind::Value,
+                    _ => Kind::Meshing,
+                };
+                Failure::new(kind, format!("{name}: {e}"))
+            })?;
             (s, Some(r))
         }
     };

@@ -88,6 +88,28 @@ def test_bad_options_raise_value_errors():
         biotet.mesh_file(SHAPES / "tm_box.off", labels={"other.off": [1]})
 
 
+# Each a ValueError naming the option (a MeshingError, or an OverflowError naming no option,
+# until session 32), and the surface stage's prefix said once.
+@pytest.mark.parametrize("kwargs, name", [
+    ({"surface_tolerance": 0}, "tolerance"),
+    ({"surface_tolerance": float("nan")}, "surface_tolerance"),
+    ({"surface_tolerance": 0.1, "surface_feature_angle": -5.0}, "feature angle"),
+    ({"resolution": 0}, "resolution"),
+    ({"resolution": float("inf")}, "resolution"),
+    ({"max_voxels": -1}, "max_voxels"),
+    ({"surface_rounds": -1}, "surface_rounds"),
+    ({"labels": [-3]}, "labels"),
+    ({"labels": [2**40]}, "labels"),
+    ({"labels": [1.7]}, "labels"),
+])
+def test_out_of_range_options_are_value_errors_naming_them(kwargs, name):
+    p, t = cube()
+    with pytest.raises(ValueError) as e:
+        biotet.mesh(p, t, **kwargs)
+    assert name in str(e.value), str(e.value)
+    assert str(e.value).count("surface stage") <= 1, str(e.value)
+
+
 def test_write_nothing_on_a_failed_write(tmp_path):
     p, t = cube()
     m = biotet.mesh(p, t)

@@ -108,6 +108,25 @@ def test_progress_callable_sees_the_stages():
     assert any("recover" in s or "Delaunay" in s or "delaunay" in s for s in seen), seen
 
 
+def test_progress_callable_sees_the_surface_stage_steps():
+    # Each step of the stage is a progress point (Ctrl-C stops the call at the next one); the
+    # stage was one point, so a long run could not be stopped for minutes.
+    seen = []
+    p, t = cube(side=2.0)
+    biotet.mesh(p, t, surface_tolerance=0.05, progress=seen.append)
+    steps = [s for s in seen if s.startswith("improving the surface: ")]
+    assert any("round" in s for s in steps) and any("measuring" in s for s in steps), seen
+
+
+def test_labels_beyond_the_template_are_renumbered_and_put_back():
+    # An extracted segmentation keeps its values (FreeSurfer's 2035): mesh() took at most 8191,
+    # as mesh_image() did not.
+    p, t = cube()
+    m = biotet.mesh(p, t, labels=[9000])
+    assert set(np.unique(m.labels)) == {9000}
+    assert biotet.check(m, (p, t), labels=[9000])["valid"]
+
+
 def test_delaunay_recover_improve_smooth_chain():
     src = SHAPES / "cad_as1_nut_default.off"
     s = biotet.read_surface(src)

@@ -226,11 +226,12 @@ pub fn run(a: Args) -> Result<ExitCode> {
     };
     let seconds_read = clock.elapsed().as_secs_f64();
     // Image labels are the image's values (FreeSurfer's 2035 stays 2035); the template holds
-    // small labels, so they are renumbered for meshing and put back after.
+    // small labels, so they are renumbered for meshing and put back after (a surface's too,
+    // when it uses one the template cannot hold).
     let mut surface = surface;
-    let compaction = image
-        .as_ref()
-        .map(|_| biotet::image::labels::Compaction::of_surface(&mut surface));
+    use biotet::image::labels::Compaction;
+    let compaction = (image.is_some() || Compaction::needed(&surface))
+        .then(|| Compaction::of_surface(&mut surface));
     // The surface stage (opt-in for a surface, the default for an image): the improved surface
     // replaces the input from here on.
     let tolerance = match &image {

@@ -22,6 +22,7 @@ arguments, and ``OSError`` subclasses for files, with the CLI's messages. Progre
 from __future__ import annotations
 
 import json
+import math
 import logging
 import os
 from dataclasses import dataclass, field
@@ -128,6 +129,20 @@ def _label(x: Any, what: str) -> int:
     if isinstance(x, bool) or not isinstance(x, (int, np.integer)) or not 0 <= x <= _LABEL_MAX:
         raise ValueError(f"{what}: {x!r} is not a label (an integer in 0..2**31)")
     return int(x)
+
+
+def _positive(what: str, x: Any) -> None:
+    """A positive finite number, or a ``ValueError`` naming ``what``."""
+    ok = isinstance(x, (int, float, np.integer, np.floating)) and not isinstance(x, bool)
+    if not (ok and math.isfinite(x) and x > 0):
+        raise ValueError(f"{what} must be a positive finite number, got {x!r}")
+
+
+def _count(what: str, x: Any, least: int) -> None:
+    """A whole number at least ``least`` (and under 2**63), or a ``ValueError`` naming it."""
+    ok = isinstance(x, (int, np.integer)) and not isinstance(x, bool)
+    if not (ok and least <= x < 2**63):
+        raise ValueError(f"{what} must be a whole number of at least {least}, got {x!r}")
 
 
 def _progress(progress: Callable[[str], Any] | None) -> Callable[[str], Any] | None:
@@ -268,7 +283,12 @@ def _mesh_options(
     exact_surface: bool = False,
 ) -> dict:
     """The options of ``mesh``, ``mesh_image`` and ``mesh_file`` as the native module reads
-    them."""
+    them; a number out of its range is a ``ValueError`` naming it."""
+    _positive("resolution", resolution)
+    if surface_tolerance is not None:
+        _positive("surface_tolerance", surface_tolerance)
+    _count("max_voxels", max_voxels, 1)
+    _count("surface_rounds", surface[1], 0)
     return dict(
         size=size,
         grading=grading,
@@ -465,7 +485,7 @@ def mesh(
     v = _points(vertices, "vertices")
     f = _indices(faces, 3, "faces")
     s = None if side_labels is None else _indices(side_labels, 2, "side_labels")
-    shell = None if labels is None else [int(x) for x in labels]
+    shell = None if labels is None else [_label(x, "labels") for x in labels]
     o = _mesh_options(
         size, grading, min_size, max_size, region_sizes, resolution, zone, max_voxels,
         steiner, (recover, improve, smooth, polish), surface_tolerance,
@@ -623,7 +643,7 @@ def mesh_file(
         hits = [i for i, p in enumerate(ps) if p == key or os.path.basename(p) == key]
         if not hits:
             raise ValueError(f"labels: {key} is not one of the input files")
-        per_file[hits[0]] = [int(x) for x in ls]
+        per_file[hits[0]] = [_label(x, "labels") for x in ls]
     img = _image_options(keep_labels, merge, outside, min_component_voxels)
     o = _mesh_options(
         size, grading, min_size, max_size, region_sizes, resolution, zone, max_voxels,
@@ -697,7 +717,7 @@ def check(mesh: TetMesh, surface: Surface | tuple[Any, Any] | None = None, *,
     of the mesh with the right regions on its sides. Returns the report; ``report["valid"]`` is
     the verdict."""
     sp, st = _surface_arrays(surface)
-    shell = None if labels is None else [int(x) for x in labels]
+    shell = None if labels is None else [_label(x, "labels") for x in labels]
     return json.loads(_call(_core.check, *_mesh_arrays(mesh), sp, st, shell,
                             _side_labels(surface), threads=_threads(threads)))
 

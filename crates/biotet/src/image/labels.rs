@@ -290,6 +290,16 @@ impl Compaction {
         c
     }
 
+    /// Whether `s` uses a label the template cannot hold, so it must be renumbered to mesh
+    /// (an image's surface always is; a surface's labels only when they are that large, as
+    /// FreeSurfer's 2035 and the labels of an extracted segmentation can be).
+    pub fn needed(s: &crate::SurfaceMesh) -> bool {
+        s.sides
+            .iter()
+            .flatten()
+            .any(|&l| l > crate::template::voxels::MAX_REGION)
+    }
+
     /// The compact label of an image label.
     pub fn compact(&self, label: u32) -> Option<u32> {
         self.original.binary_search(&label).ok().map(|i| i as u32)
