@@ -16,7 +16,7 @@ pub fn dihedral_angles(c: &[[f64; 3]; 4]) -> [f64; 6] {
         // The two faces at edge ij are those opposite the other two vertices k, l.
         let [k, l] = TET_EDGES[5 - e];
         debug_assert!(k != i && k != j && l != i && l != j);
-        let (nk, nl) = (n[k], n[l]);
+        let (nk, nl) = balanced(n[k], n[l]);
         // Interior angle = π − angle between outward normals.
         out[e] = norm(cross(nk, nl)).atan2(-dot(nk, nl));
     }
@@ -40,7 +40,7 @@ pub fn dihedral_yx(c: &[[f64; 3]; 4]) -> [[f64; 2]; 6] {
 /// `dihedral_angles(c)[e]`, for callers that need one edge.
 pub fn dihedral_at(c: &[[f64; 3]; 4], e: usize) -> f64 {
     let [k, l] = TET_EDGES[5 - e];
-    let (nk, nl) = (face_normal(c, k), face_normal(c, l));
+    let (nk, nl) = balanced(face_normal(c, k), face_normal(c, l));
     norm(cross(nk, nl)).atan2(-dot(nk, nl))
 }
 
@@ -78,6 +78,40 @@ pub fn max_dihedral_chord2(c: &[[f64; 3]; 4]) -> f64 {
 pub fn min_dihedral_deg_by_chord(c: &[[f64; 3]; 4]) -> f64 {
     let half_chord = 0.5 * min_dihedral_chord2(c).sqrt();
     2.0 * half_chord.min(1.0).asin().to_degrees()
+}
+
+/// `a` and `b` scaled by one power of two so that their largest component is about 1 when it
+/// lies outside 1e-60..1e60: the squares in the angle between them (a face normal is the square
+/// of the tet's size, their cross product its fourth power) then neither overflow nor underflow
+/// on a tet 1e40 across or 1e-40 (90° and 0° came out for any tet there). A power of two scales
+/// exactly and `atan2` sees both arguments scaled alike, so the angle is the same to the bit;
+/// inside the range nothing is scaled.
+fn balanced(a: [f64; 3], b: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+    let m = a.iter().chain(&b).fold(0.0f64, |m, x| m.max(x.abs()));
+    if m == 0.0 || !m.is_finite() || (1e-60..=1e60).contains(&m) {
+        return (a, b);
+    }
+    let s = 2f64.powi(-(m.log2().round() as i32));
+    (scale(a, s), scale(b, s))
+}
+
+/// `c` scaled by one power of two to about unit size when its extent lies outside 1e-30..1e30
+/// (and the scaled corners are finite), for measures whose terms take high powers of the size;
+/// exact, so the measure's bits do not change, and inside the range nothing is scaled.
+fn sized(c: &[[f64; 3]; 4]) -> [[f64; 3]; 4] {
+    let ext = (1..4)
+        .flat_map(|i| (0..3).map(move |k| (c[i][k] - c[0][k]).abs()))
+        .fold(0.0f64, f64::max);
+    if ext == 0.0 || !ext.is_finite() || (1e-30..=1e30).contains(&ext) {
+        return *c;
+    }
+    let s = 2f64.powi(-(ext.log2().round() as i32));
+    let out = c.map(|p| scale(p, s));
+    if out.iter().flatten().all(|x| x.is_finite()) {
+        out
+    } else {
+        *c
+    }
 }
 
 /// Outward normals (length = twice the face area) of the faces opposite each vertex, for a
@@ -162,6 +196,8 @@ pub fn q_measure(c: &[[f64; 3]; 4]) -> f64 {
 
 /// Radius ratio 3·r_in / R_circ: 1 for the regular tet, 0 for a flat one, negative when inverted.
 pub fn radius_ratio(c: &[[f64; 3]; 4]) -> f64 {
+    // Its circumradius takes the eighth power of the tet's size.
+    let c = &sized(c);
     let det = volume6(c[0], c[1], c[2], c[3]);
     if det == 0.0 {
         return 0.0;

@@ -833,3 +833,29 @@ fn single_edge_dihedral_and_chord_agree_with_all_angles() {
         );
     }
 }
+
+/// A tet's measures do not depend on its size: the same at 1e±40 and 1e±50 as at unit size.
+/// A face normal is the square of the size and the circumradius's terms its eighth power, so the
+/// dihedral angles came out 90° at 1e40 (0° and 180° at 1e-45) and the radius ratio 0, for any
+/// tet (found by a Python user; the API takes coordinates from 1e-45 to 1e50).
+#[test]
+fn measures_do_not_depend_on_the_size_of_the_tet() {
+    let c = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.1, 0.0],
+        [0.3, 0.9, 0.2],
+        [0.2, 0.3, 0.8],
+    ];
+    let unit = TetMeasures::of(&c);
+    for s in [1e40, 1e-40, 1e50, 1e-45] {
+        let m = TetMeasures::of(&c.map(|p| p.map(|x| x * s)));
+        for (a, b) in m.dihedral_deg.iter().zip(&unit.dihedral_deg) {
+            close(*a, *b, 1e-9);
+        }
+        close(m.radius_ratio, unit.radius_ratio, 1e-9);
+        close(m.q, unit.q, 1e-9);
+        for (a, b) in m.solid_sr.iter().zip(&unit.solid_sr) {
+            close(*a, *b, 1e-9);
+        }
+    }
+}
