@@ -446,6 +446,7 @@ pub fn one_sided(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::SurfaceMesh;
     use crate::surface::tests::uv_sphere;
 
     fn index(pts: &[P3], tris: &[[u32; 3]]) -> PatchIndex {
@@ -486,30 +487,43 @@ mod tests {
         assert!(tight.far.is_empty());
     }
 
-    /// The bound holds: two spheres of different resolution and radius, measured with a limit
-    /// under the Lipschitz bound (so cells are proven by convexity where they can be), against
-    /// samples fifty times denser.
-    #[test]
-    fn the_cells_bound_is_an_upper_bound() {
+    /// `from`'s distance to `to` (one sheet), as [`one_sided`] measures it.
+    fn measured(
+        from: &SurfaceMesh,
+        to: &SurfaceMesh,
+        spacing: f64,
+        fine: f64,
+        limit: f64,
+    ) -> Sided {
+        let idx = index(&to.points, &to.triangles);
+        let sides = vec![[0, 1]; from.triangles.len()];
+        one_sided(
+            &from.points,
+            &from.triangles,
+            &sides,
+            None,
+            &idx,
+            spacing,
+            fine,
+            limit,
+            limit,
+            0.0,
+        )
+    }
+
+    /// Two spheres of different resolution and radius, each way.
+    fn sphere_pairs() -> [(SurfaceMesh, SurfaceMesh); 2] {
         let a = uv_sphere(1.0, [0.0; 3], 24, 12);
         let b = uv_sphere(1.02, [0.01, 0.0, 0.0], 17, 9);
-        for (from, to) in [(&a, &b), (&b, &a)] {
-            let idx = index(&to.points, &to.triangles);
-            let sides = vec![[0, 1]; from.triangles.len()];
-            let m = |spacing: f64, limit: f64| {
-                one_sided(
-                    &from.points,
-                    &from.triangles,
-                    &sides,
-                    None,
-                    &idx,
-                    spacing,
-                    spacing,
-                    limit,
-                    limit,
-                    0.0,
-                )
-            };
+        [(a.clone(), b.clone()), (b, a)]
+    }
+
+    /// The bound holds: two spheres, measured with a limit under the Lipschitz bound (so cells
+    /// are proven by convexity where they can be), against samples fifty times denser.
+    #[test]
+    fn the_cells_bound_is_an_upper_bound() {
+        for (from, to) in sphere_pairs() {
+            let m = |spacing: f64, limit: f64| measured(&from, &to, spacing, spacing, limit);
             let dense = m(0.004, f64::INFINITY);
             let coarse = m(0.2, f64::INFINITY);
             let cells = m(0.2, 0.5 * (coarse.bound + dense.max));
@@ -529,28 +543,10 @@ mod tests {
     /// thousands of times more), and the bound is still above the dense grid's maximum.
     #[test]
     fn a_tight_limit_is_proven_where_the_distance_comes_near_it() {
-        let a = uv_sphere(1.0, [0.0; 3], 24, 12);
-        let b = uv_sphere(1.02, [0.01, 0.0, 0.0], 17, 9);
-        for (from, to) in [(&a, &b), (&b, &a)] {
-            let idx = index(&to.points, &to.triangles);
-            let sides = vec![[0, 1]; from.triangles.len()];
-            let m = |spacing: f64, fine: f64, limit: f64| {
-                one_sided(
-                    &from.points,
-                    &from.triangles,
-                    &sides,
-                    None,
-                    &idx,
-                    spacing,
-                    fine,
-                    limit,
-                    limit,
-                    0.0,
-                )
-            };
-            let dense = m(0.004, 0.004, f64::INFINITY);
+        for (from, to) in sphere_pairs() {
+            let dense = measured(&from, &to, 0.004, 0.004, f64::INFINITY);
             let limit = 1.01 * dense.max;
-            let tight = m(0.2, 0.2 / 1024.0, limit);
+            let tight = measured(&from, &to, 0.2, 0.2 / 1024.0, limit);
             assert!(tight.bound <= limit, "{} > {limit}", tight.bound);
             assert!(tight.bound >= dense.max, "{} < {}", tight.bound, dense.max);
             assert!(tight.far.is_empty());
