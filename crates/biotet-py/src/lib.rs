@@ -306,6 +306,8 @@ fn mesh_with(
             })?;
         }
     }
+    biotet::sizing::check_region_labels(&surface, &sizing.region_sizes)
+        .map_err(|e| Failure::new(Kind::Value, format!("region_sizes: {e}")))?;
     let sizing = Sizing::new(&surface, sizing)
         .map_err(|e| Failure::new(Kind::Value, format!("sizing: {e}")))?;
     let seconds_sizing = clock.elapsed().as_secs_f64();

@@ -89,7 +89,8 @@ def test_bad_options_raise_value_errors():
 
 
 # Each a ValueError naming the option (a MeshingError, or an OverflowError naming no option,
-# until session 32), and the surface stage's prefix said once.
+# until session 32; a size for a region the surface lacks was ignored), and the surface stage's
+# prefix said once.
 @pytest.mark.parametrize("kwargs, name", [
     ({"surface_tolerance": 0}, "tolerance"),
     ({"surface_tolerance": float("nan")}, "surface_tolerance"),
@@ -101,6 +102,7 @@ def test_bad_options_raise_value_errors():
     ({"labels": [-3]}, "labels"),
     ({"labels": [2**40]}, "labels"),
     ({"labels": [1.7]}, "labels"),
+    ({"region_sizes": {5: 0.1}}, "region_sizes"),
 ])
 def test_out_of_range_options_are_value_errors_naming_them(kwargs, name):
     p, t = cube()

@@ -277,6 +277,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
                 .with_context(|| format!("--region-size: no region {l} in the image"))?;
         }
     }
+    biotet::sizing::check_region_labels(&surface, &sizing.region_sizes).context("--region-size")?;
     let sizing = Sizing::new(&surface, sizing).context("sizing")?;
     // Part of meshing: the surface-derived size is built from the surface here.
     let seconds_sizing = clock.elapsed().as_secs_f64();

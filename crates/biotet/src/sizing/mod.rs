@@ -145,6 +145,46 @@ pub enum SizingError {
     /// Sizing from a surface that has no edges.
     #[error("the surface has no triangles to take sizes from")]
     EmptySurface,
+    /// A size asked for a region the surface does not bound.
+    #[error("a size for region {label}, which the surface does not bound (its regions: {regions})")]
+    NoRegion {
+        /// The label asked for.
+        label: u32,
+        /// The surface's region labels, comma-separated.
+        regions: String,
+    },
+}
+
+/// Refuse a size for a region `surface` does not bound (a mistyped label would otherwise be
+/// ignored silently): for the caller that meshes the whole surface, not for one that meshes a
+/// part of it (`biotet remesh`'s cavities).
+pub fn check_region_labels(
+    surface: &SurfaceMesh,
+    region_sizes: &[(u32, f64)],
+) -> Result<(), SizingError> {
+    let mut labels: Vec<u32> = surface
+        .sides
+        .iter()
+        .flatten()
+        .copied()
+        .filter(|&l| l != 0)
+        .collect();
+    labels.sort_unstable();
+    labels.dedup();
+    match region_sizes
+        .iter()
+        .find(|(l, _)| labels.binary_search(l).is_err())
+    {
+        None => Ok(()),
+        Some(&(label, _)) => Err(SizingError::NoRegion {
+            label,
+            regions: labels
+                .iter()
+                .map(|l| l.to_string())
+                .collect::<Vec<_>>()
+                .join(", "),
+        }),
+    }
 }
 
 /// A sizing function: the desired edge length at a point of a region.
