@@ -277,11 +277,8 @@ pub struct Compaction {
 impl Compaction {
     /// Renumber a surface's labels in increasing order of value (0 stays 0).
     pub fn of_surface(s: &mut crate::SurfaceMesh) -> Compaction {
-        let mut labels: Vec<u32> = s.sides.iter().flatten().copied().collect();
-        labels.push(0);
-        labels.sort_unstable();
-        labels.dedup();
-        let c = Compaction { original: labels };
+        let original = std::iter::once(0).chain(s.regions()).collect();
+        let c = Compaction { original };
         for side in s.sides.iter_mut() {
             for l in side.iter_mut() {
                 *l = c.compact(*l).expect("every label is listed");
@@ -294,10 +291,9 @@ impl Compaction {
     /// (an image's surface always is; a surface's labels only when they are that large, as
     /// FreeSurfer's 2035 and the labels of an extracted segmentation can be).
     pub fn needed(s: &crate::SurfaceMesh) -> bool {
-        s.sides
-            .iter()
-            .flatten()
-            .any(|&l| l > crate::template::voxels::MAX_REGION)
+        s.regions()
+            .last()
+            .is_some_and(|&l| l > crate::template::voxels::MAX_REGION)
     }
 
     /// The compact label of an image label.

@@ -80,32 +80,36 @@ pub fn min_dihedral_deg_by_chord(c: &[[f64; 3]; 4]) -> f64 {
     2.0 * half_chord.min(1.0).asin().to_degrees()
 }
 
-/// `a` and `b` scaled by one power of two so that their largest component is about 1 when it
-/// lies outside 1e-60..1e60: the squares in the angle between them (a face normal is the square
-/// of the tet's size, their cross product its fourth power) then neither overflow nor underflow
-/// on a tet 1e40 across or 1e-40 (90° and 0° came out for any tet there). A power of two scales
-/// exactly and `atan2` sees both arguments scaled alike, so the angle is the same to the bit;
-/// inside the range nothing is scaled.
-fn balanced(a: [f64; 3], b: [f64; 3]) -> ([f64; 3], [f64; 3]) {
-    let m = a.iter().chain(&b).fold(0.0f64, |m, x| m.max(x.abs()));
-    if m == 0.0 || !m.is_finite() || (1e-60..=1e60).contains(&m) {
-        return (a, b);
-    }
-    let s = 2f64.powi(-(m.log2().round() as i32));
-    (scale(a, s), scale(b, s))
+/// The power of two that brings `m` (a largest magnitude) to about 1, when `m` lies outside
+/// `1/range..range`; `None` inside it (or for 0 and non-finite `m`). Scaling by a power of two
+/// is exact, so a measure of scaled values has the same bits as of the originals wherever the
+/// originals did not over- or underflow.
+fn unit_scale(m: f64, range: f64) -> Option<f64> {
+    (m != 0.0 && m.is_finite() && !(1.0 / range..=range).contains(&m))
+        .then(|| 2f64.powi(-(m.log2().round() as i32)))
 }
 
-/// `c` scaled by one power of two to about unit size when its extent lies outside 1e-30..1e30
-/// (and the scaled corners are finite), for measures whose terms take high powers of the size;
-/// exact, so the measure's bits do not change, and inside the range nothing is scaled.
+/// `a` and `b` scaled alike by [`unit_scale`] beyond 1e±60: the squares in the angle between
+/// them (a face normal is the square of the tet's size, their cross product its fourth power)
+/// then neither overflow nor underflow on a tet 1e40 across or 1e-40 (90° and 0° came out for
+/// any tet there); `atan2` sees both arguments scaled alike, so the angle is the same.
+fn balanced(a: [f64; 3], b: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+    let m = a.iter().chain(&b).fold(0.0f64, |m, x| m.max(x.abs()));
+    match unit_scale(m, 1e60) {
+        Some(s) => (scale(a, s), scale(b, s)),
+        None => (a, b),
+    }
+}
+
+/// `c` scaled by [`unit_scale`] of its extent beyond 1e±30 (when the scaled corners are
+/// finite), for measures whose terms take high powers of the size.
 fn sized(c: &[[f64; 3]; 4]) -> [[f64; 3]; 4] {
     let ext = (1..4)
         .flat_map(|i| (0..3).map(move |k| (c[i][k] - c[0][k]).abs()))
         .fold(0.0f64, f64::max);
-    if ext == 0.0 || !ext.is_finite() || (1e-30..=1e30).contains(&ext) {
+    let Some(s) = unit_scale(ext, 1e30) else {
         return *c;
-    }
-    let s = 2f64.powi(-(ext.log2().round() as i32));
+    };
     let out = c.map(|p| scale(p, s));
     if out.iter().flatten().all(|x| x.is_finite()) {
         out

@@ -162,15 +162,7 @@ pub fn check_region_labels(
     surface: &SurfaceMesh,
     region_sizes: &[(u32, f64)],
 ) -> Result<(), SizingError> {
-    let mut labels: Vec<u32> = surface
-        .sides
-        .iter()
-        .flatten()
-        .copied()
-        .filter(|&l| l != 0)
-        .collect();
-    labels.sort_unstable();
-    labels.dedup();
+    let labels = surface.regions();
     match region_sizes
         .iter()
         .find(|(l, _)| labels.binary_search(l).is_err())
