@@ -207,6 +207,14 @@ pub fn report_text(r: &SurfaceReport) -> String {
         r.ops.moves,
         r.repair_rounds
     );
+    if r.retries > 0 {
+        t += &format!(
+            "\n  ran {} more time{} with smaller working tolerances: the repairs had left the \
+             surface beyond the tolerance",
+            r.retries,
+            if r.retries == 1 { "" } else { "s" }
+        );
+    }
     t
 }
 

@@ -90,6 +90,19 @@ pub enum TriTri {
     Improper,
 }
 
+/// Whether triangles `t` and `u` of an indexed surface (corner indices `ti`, `ui`) meet other
+/// than in the corners they share by index: a corner of one on a corner of the other with
+/// another index is two points in one place, a pinch, however legal the coordinates alone look.
+pub fn meet_improperly(t: &[P3; 3], ti: [u32; 3], u: &[P3; 3], ui: [u32; 3]) -> bool {
+    let shared = ti.iter().filter(|v| ui.contains(v)).count();
+    match tri_tri(t, u) {
+        TriTri::Disjoint => false,
+        TriTri::SharedVertex { .. } => shared != 1,
+        TriTri::SharedEdge { .. } => shared != 2,
+        TriTri::Improper => true,
+    }
+}
+
 impl TriTri {
     /// Whether this is a legal contact for two triangles of a surface: disjoint, or sharing a
     /// vertex or an edge and nothing more.
@@ -400,6 +413,26 @@ mod tests {
     use super::*;
 
     const T: [P3; 3] = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+
+    /// Two triangles touching at one place are a proper pair only if that place is one corner
+    /// by index: two points with the same coordinates make a pinch.
+    #[test]
+    fn a_shared_place_is_a_shared_corner_only_by_index() {
+        let u = [[0.0, 0.0, 0.0], [-1.0, 0.0, 1.0], [0.0, -1.0, 1.0]];
+        assert!(matches!(tri_tri(&T, &u), TriTri::SharedVertex { .. }));
+        assert!(!meet_improperly(&T, [0, 1, 2], &u, [0, 3, 4]));
+        assert!(meet_improperly(&T, [0, 1, 2], &u, [5, 3, 4]));
+        // An edge in one place: two shared corners by index, or it is a pinch along it.
+        let w = [[1.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 1.0]];
+        assert!(!meet_improperly(&T, [0, 1, 2], &w, [1, 0, 6]));
+        assert!(meet_improperly(&T, [0, 1, 2], &w, [1, 7, 6]));
+        assert!(!meet_improperly(
+            &T,
+            [0, 1, 2],
+            &[[5.0; 3], [6.0, 5.0, 5.0], [5.0, 6.0, 5.0]],
+            [0, 1, 2]
+        ));
+    }
 
     #[test]
     fn segment_triangle_cases() {

@@ -63,7 +63,7 @@ use std::fmt;
 
 use rayon::prelude::*;
 
-use crate::geom::intersect::{SegPart, SegTri, TriTri, is_degenerate, seg_tri, tri_tri};
+use crate::geom::intersect::{SegPart, SegTri, is_degenerate, meet_improperly, seg_tri};
 use crate::mesh::dsu::Dsu;
 use crate::mesh::surface::SurfaceMesh;
 
@@ -1811,15 +1811,7 @@ impl Bvh {
 
 /// Whether triangles `i` and `j` meet other than in the vertices they share by index.
 fn improper_pair(s: &SurfaceMesh, i: usize, j: usize) -> bool {
-    let (a, b) = (s.triangles[i], s.triangles[j]);
-    let shared = a.iter().filter(|v| b.contains(v)).count();
-    match tri_tri(&s.corners(i), &s.corners(j)) {
-        TriTri::Disjoint => false,
-        // Geometric sharing beyond index sharing means touching at an unwelded point.
-        TriTri::SharedVertex { .. } => shared != 1,
-        TriTri::SharedEdge { .. } => shared != 2,
-        TriTri::Improper => true,
-    }
+    meet_improperly(&s.corners(i), s.triangles[i], &s.corners(j), s.triangles[j])
 }
 
 /// The number of improperly intersecting pairs and the `k` lowest ones `(i, j)`, `i < j`.

@@ -15,9 +15,11 @@
 //!    self-intersection test), and the measure of the two-sided distance with dense samples
 //!    ([`hausdorff::one_sided`] both ways); where it finds the output beyond `D`, or cannot
 //!    prove it within, the repair: the output triangles there are refined (the longest edge
-//!    split, the new point projected onto the input) and the output validated and measured
-//!    again (at most four times, `REPAIRS`); the run fails with [`SurfaceError::Tolerance`] if the
-//!    distance still exceeds `D`.
+//!    split, the new point projected onto the input) and the output validated and measured again (at most
+//!    four times, `REPAIRS`);
+//! 4. if the distance still exceeds `D`, steps 2–3 run again with their working tolerances
+//!    scaled down (at most twice, `RETRIES`); the stage fails with [`SurfaceError::Tolerance`]
+//!    only if that does not bring it within `D` either.
 //!
 //! Everything is sequential except the measures (parallel, order-independent), so the output is
 //! the same on any number of threads.
@@ -177,8 +179,11 @@ pub struct SurfaceReport {
     pub n_rim_edges: usize,
     /// Operations applied.
     pub ops: remesh::OpCounts,
-    /// Repair rounds run.
+    /// Repair rounds run (in the run kept).
     pub repair_rounds: usize,
+    /// Runs again with the working tolerances scaled down, after a run the repairs could not
+    /// bring within the tolerance.
+    pub retries: usize,
     /// Wall-clock seconds.
     pub seconds: f64,
     /// Seconds of the remeshing rounds and the clean-up.
@@ -360,131 +365,38 @@ pub fn improve_with_progress(
     let spacing = opts.sample_spacing.unwrap_or(d.min(0.25 * l).max(l / 32.0));
     let f = features::find(surface, opts.feature_angle_deg);
     let index = PatchIndex::new(&surface.points, &surface.triangles, &surface.sides, None);
-    // Input samples for the in→out guard, spaced D (at least a quarter edge length).
-    let samples = guard::InputSamples::new(surface, d.max(l / 4.0));
-    let point_size = if opts.adaptive {
-        size::point_sizes(surface, 0.7 * d, l / 2.0, l, 0.5)
-    } else {
-        vec![l; surface.points.len()]
+    // A run whose repairs cannot bring the output within D runs again, its working tolerances
+    // (the loop's, the guard's samples') scaled down: the input is within any D of itself, so
+    // a closer run comes within it (a thin CAD tube whose 90° rims are no features at D = 0.5%
+    // of its size: the repairs' splits and moves could not follow the rims within four rounds).
+    let mut w = d;
+    let mut retries = 0;
+    // Validation, features and the input's index count as remeshing.
+    let mut seconds = [clock.elapsed().as_secs_f64(), 0.0];
+    let run = loop {
+        let run = remesh_within(surface, &f, &index, opts, l, spacing, d, w, progress)?;
+        seconds[0] += run.seconds_remesh;
+        seconds[1] += run.seconds_measure;
+        if run.oi.max.max(run.io.max) <= d || retries == RETRIES {
+            break run;
+        }
+        retries += 1;
+        w *= RETRY_SCALE;
+        progress(&format!(
+            "again, within {} of the tolerance",
+            short(&(w / d))
+        ));
     };
-    let tri_size: Vec<f64> = surface
-        .triangles
-        .iter()
-        .map(|t| t.iter().map(|&v| point_size[v as usize]).fold(l, f64::min))
-        .collect();
-    // Long edges cut to the target first: the rounds' midpoint splits would fan them out.
-    let start = presplit::presplit(surface, &f, &samples, &point_size, l);
-    let cut_features;
-    let (s0, f0, cover, size0) = match &start {
-        Some(st) => {
-            cut_features = Features {
-                fixed: st.fixed.clone(),
-                edges: st.edges.clone(),
-                ..f.clone()
-            };
-            let cover = Some(st.cover.as_slice());
-            (&st.mesh, &cut_features, cover, st.point_size.as_slice())
-        }
-        None => (surface, &f, None, point_size.as_slice()),
-    };
-    let mut r = remesh::Remesher::new(
-        s0,
-        f0,
-        &index,
-        &samples,
-        cover,
-        size0,
-        &tri_size,
-        l,
-        0.7 * d,
-    );
-    // The loop keeps its samples within 0.7 D; the final measure then has room.
-    r.spacing = (0.25 * l).max(d);
-    r.target_angle = opts.target_angle_deg;
-    r.open_necks();
-    for k in 0..opts.rounds {
-        progress(&format!("round {} of {}", k + 1, opts.rounds));
-        r.round();
-        // The rounds make necks as they collapse; open each as it appears (the last round's
-        // before the clean-up).
-        r.open_necks();
-    }
-    progress("clean-up");
-    // The clean-up may use a little more of the tolerance (the final measure has room).
-    r.tol = 0.8 * d;
-    // Then again with the needles whose short edge neither end can move along (longer than
-    // the tolerance) collapsed to their middle; only now, so the first pass has done what it
-    // can (wm_20k: a 1.4° tet where both ran in one pass, none under 10° this way).
-    for middle in [false, true] {
-        r.middle = middle;
-        for _ in 0..6 {
-            let since = r.clock();
-            if r.clean_up() == 0 {
-                break;
-            }
-            r.flips_since(since);
-        }
-    }
-    // Folds the triangles' own angles do not see (a thin finger's flat tip) force tets as
-    // sharp as they are.
-    let mut folds_opened = r.open_folds();
-    // Validate and measure; where the dense measure finds the output beyond D or cannot prove
-    // it within, split there and project (the repair), validate and measure again, a bounded
-    // number of times. (A coarser repair pass before it, splitting wherever a sample was beyond
-    // 0.9 D, cost 0.35 s on wm_20k and 0.9 s on the nested model, and the measure passes there
-    // without it.)
-    let seconds_remesh = clock.elapsed().as_secs_f64();
-    r.repairing = true;
-    let mut repair_rounds = 0;
-    // The input samples found beyond D by the last measure.
-    let mut far_before: FxHashSet<[u64; 3]> = FxHashSet::default();
-    let mut seconds_measure = 0.0;
-    // The best output measured so far: none with a sample beyond D first, then the fewest
-    // triangles beyond D or unproven. Once the best has no sample beyond D, a repair round that
-    // does not improve on it ends the repairs (at a tolerance too small for the samples to
-    // prove, a millionth of the model's size, each round split more triangles and proved
-    // none), and the best is kept.
-    let mut best: Option<((bool, usize), Measured)> = None;
-    let (out, oi, io, repair_rounds) = loop {
-        progress("validating");
-        let mut out = r.to_surface();
-        validate_surface(
-            &mut out,
-            &ValidateOptions {
-                fix_inward: false,
-                ..Default::default()
-            },
-        )
-        .map_err(SurfaceError::Output)?;
-        progress("measuring");
-        let (oi, io) = final_measure(surface, &out, &index, spacing, d);
-        if repair_rounds == 0 {
-            seconds_measure = clock.elapsed().as_secs_f64() - seconds_remesh;
-        }
-        // Beyond: a sample over D, or a bound the finest samples cannot bring under it.
-        let beyond = oi.bound.max(io.bound) > d;
-        let key = (oi.max.max(io.max) > d, oi.far.len() + io.far.len());
-        let stuck = best.as_ref().is_some_and(|b| b.0 <= key && !b.0.0);
-        // `out` lists the alive triangles of `r` in order.
-        let ids: Vec<u32> = (0..r.tris.len() as u32)
-            .filter(|&t| r.alive[t as usize])
-            .collect();
-        let last = stuck || !beyond || repair_rounds == REPAIRS || ids.len() != out.triangles.len();
-        if !last {
-            progress("repair");
-            refine_where_far(&mut r, &oi, &io, &far_before, |t| ids[t as usize]);
-            far_before = io.far.iter().map(|x| x.point.map(f64::to_bits)).collect();
-        }
-        if best.as_ref().is_none_or(|b| key < b.0) {
-            best = Some((key, (out, oi, io, repair_rounds)));
-        }
-        if last {
-            break best.take().map(|b| b.1).expect("a measured output");
-        }
-        // The splits and projections may fold the surface again.
-        folds_opened += r.open_folds();
-        repair_rounds += 1;
-    };
+    let [seconds_remesh, seconds_measure] = seconds;
+    let Run {
+        out,
+        oi,
+        io,
+        repair_rounds,
+        counts,
+        folds_opened,
+        ..
+    } = run;
     let seconds_repair = clock.elapsed().as_secs_f64() - seconds_remesh - seconds_measure;
     if oi.max > d || io.max > d {
         return Err(SurfaceError::Tolerance {
@@ -565,8 +477,9 @@ pub fn improve_with_progress(
         n_fold_moves: folds_opened,
         n_sharp_edges: f.n_sharp,
         n_rim_edges: f.n_rim,
-        ops: r.counts,
+        ops: counts,
         repair_rounds,
+        retries,
         seconds: clock.elapsed().as_secs_f64(),
         seconds_remesh,
         seconds_repair,
@@ -574,6 +487,166 @@ pub fn improve_with_progress(
     };
     Ok((out, report))
 }
+
+/// One run of the remeshing rounds, the clean-up and the repairs ([`improve_with_progress`]),
+/// its working tolerances from `w` (the tolerance `d`, or less on a retry), measured against `d`.
+#[allow(clippy::too_many_arguments)]
+fn remesh_within(
+    surface: &SurfaceMesh,
+    f: &Features,
+    index: &PatchIndex,
+    opts: &SurfaceOptions,
+    l: f64,
+    spacing: f64,
+    d: f64,
+    w: f64,
+    progress: &dyn Fn(&str),
+) -> Result<Run, SurfaceError> {
+    let clock = Instant::now();
+    // Input samples for the in→out guard, spaced D (at least a quarter edge length).
+    let samples = guard::InputSamples::new(surface, w.max(l / 4.0));
+    let point_size = if opts.adaptive {
+        size::point_sizes(surface, 0.7 * w, l / 2.0, l, 0.5)
+    } else {
+        vec![l; surface.points.len()]
+    };
+    let tri_size: Vec<f64> = surface
+        .triangles
+        .iter()
+        .map(|t| t.iter().map(|&v| point_size[v as usize]).fold(l, f64::min))
+        .collect();
+    // Long edges cut to the target first: the rounds' midpoint splits would fan them out.
+    let start = presplit::presplit(surface, f, &samples, &point_size, l);
+    let cut_features;
+    let (s0, f0, cover, size0) = match &start {
+        Some(st) => {
+            cut_features = Features {
+                fixed: st.fixed.clone(),
+                edges: st.edges.clone(),
+                ..f.clone()
+            };
+            let cover = Some(st.cover.as_slice());
+            (&st.mesh, &cut_features, cover, st.point_size.as_slice())
+        }
+        None => (surface, f, None, point_size.as_slice()),
+    };
+    let mut r = remesh::Remesher::new(s0, f0, index, &samples, cover, size0, &tri_size, l, 0.7 * w);
+    // The loop keeps its samples within 0.7 D; the final measure then has room.
+    r.spacing = (0.25 * l).max(w);
+    r.target_angle = opts.target_angle_deg;
+    r.open_necks();
+    for k in 0..opts.rounds {
+        progress(&format!("round {} of {}", k + 1, opts.rounds));
+        r.round();
+        // The rounds make necks as they collapse; open each as it appears (the last round's
+        // before the clean-up).
+        r.open_necks();
+    }
+    progress("clean-up");
+    // The clean-up may use a little more of the tolerance (the final measure has room).
+    r.tol = 0.8 * w;
+    // Then again with the needles whose short edge neither end can move along (longer than
+    // the tolerance) collapsed to their middle; only now, so the first pass has done what it
+    // can (wm_20k: a 1.4° tet where both ran in one pass, none under 10° this way).
+    for middle in [false, true] {
+        r.middle = middle;
+        for _ in 0..6 {
+            let since = r.clock();
+            if r.clean_up() == 0 {
+                break;
+            }
+            r.flips_since(since);
+        }
+    }
+    // Folds the triangles' own angles do not see (a thin finger's flat tip) force tets as
+    // sharp as they are.
+    let mut folds_opened = r.open_folds();
+    // Validate and measure; where the dense measure finds the output beyond D or cannot prove
+    // it within, split there and project (the repair), validate and measure again, a bounded
+    // number of times. (A coarser repair pass before it, splitting wherever a sample was beyond
+    // 0.9 D, cost 0.35 s on wm_20k and 0.9 s on the nested model, and the measure passes there
+    // without it.)
+    let seconds_remesh = clock.elapsed().as_secs_f64();
+    r.repairing = true;
+    let mut repair_rounds = 0;
+    // The input samples found beyond D by the last measure.
+    let mut far_before: FxHashSet<[u64; 3]> = FxHashSet::default();
+    let mut seconds_measure = 0.0;
+    // The best output measured so far: none with a sample beyond D first, then the fewest
+    // triangles beyond D or unproven. Once the best has no sample beyond D, a repair round that
+    // does not improve on it ends the repairs (at a tolerance too small for the samples to
+    // prove, a millionth of the model's size, each round split more triangles and proved
+    // none), and the best is kept.
+    let mut best: Option<((bool, usize), Measured)> = None;
+    let (out, oi, io, repair_rounds) = loop {
+        progress("validating");
+        let mut out = r.to_surface();
+        validate_surface(
+            &mut out,
+            &ValidateOptions {
+                fix_inward: false,
+                ..Default::default()
+            },
+        )
+        .map_err(SurfaceError::Output)?;
+        progress("measuring");
+        let (oi, io) = final_measure(surface, &out, index, spacing, d);
+        if repair_rounds == 0 {
+            seconds_measure = clock.elapsed().as_secs_f64() - seconds_remesh;
+        }
+        // Beyond: a sample over D, or a bound the finest samples cannot bring under it.
+        let beyond = oi.bound.max(io.bound) > d;
+        let key = (oi.max.max(io.max) > d, oi.far.len() + io.far.len());
+        let stuck = best.as_ref().is_some_and(|b| b.0 <= key && !b.0.0);
+        // `out` lists the alive triangles of `r` in order.
+        let ids: Vec<u32> = (0..r.tris.len() as u32)
+            .filter(|&t| r.alive[t as usize])
+            .collect();
+        let last = stuck || !beyond || repair_rounds == REPAIRS || ids.len() != out.triangles.len();
+        if !last {
+            progress("repair");
+            refine_where_far(&mut r, &oi, &io, &far_before, |t| ids[t as usize]);
+            far_before = io.far.iter().map(|x| x.point.map(f64::to_bits)).collect();
+        }
+        if best.as_ref().is_none_or(|b| key < b.0) {
+            best = Some((key, (out, oi, io, repair_rounds)));
+        }
+        if last {
+            break best.take().map(|b| b.1).expect("a measured output");
+        }
+        // The splits and projections may fold the surface again.
+        folds_opened += r.open_folds();
+        repair_rounds += 1;
+    };
+    Ok(Run {
+        out,
+        oi,
+        io,
+        repair_rounds,
+        counts: r.counts,
+        folds_opened,
+        seconds_remesh,
+        seconds_measure,
+    })
+}
+
+/// What [`remesh_within`] made: the output kept, its distances output → input and input →
+/// output, and how it got there.
+struct Run {
+    out: SurfaceMesh,
+    oi: hausdorff::Sided,
+    io: hausdorff::Sided,
+    repair_rounds: usize,
+    counts: remesh::OpCounts,
+    folds_opened: usize,
+    seconds_remesh: f64,
+    seconds_measure: f64,
+}
+
+/// Runs again closer ([`improve_with_progress`]) at most this many times, each with the working
+/// tolerances scaled by [`RETRY_SCALE`].
+const RETRIES: usize = 2;
+const RETRY_SCALE: f64 = 0.6;
 
 /// A measured output: the surface, its distances output → input and input → output, and the
 /// repair rounds that made it.

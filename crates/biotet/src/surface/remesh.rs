@@ -33,7 +33,7 @@ use super::bvh::{
 use super::features::{Features, key};
 use super::grid::Grid;
 use super::guard::InputSamples;
-use crate::geom::intersect::{is_degenerate, tri_tri};
+use crate::geom::intersect::{is_degenerate, meet_improperly};
 use crate::geom::vec3::bbox;
 use crate::geom::vec3::{add, cross, dot, norm, scale, sub};
 use crate::mesh::surface::SurfaceMesh;
@@ -519,13 +519,13 @@ impl<'a> Remesher<'a> {
     }
 
     /// Whether any of the proposed triangles `new` (corner ids and coordinates) meets another
-    /// triangle other than in shared corners or a shared edge; triangles in `ignore` are about
+    /// triangle other than in the corners or the edge they share by index; triangles in `ignore` are about
     /// to go and are not tested.
     fn crosses(&self, new: &[([u32; 3], [P3; 3])], ignore: &[u32]) -> bool {
         let boxes: Vec<(P3, P3)> = new.iter().map(|(_, c)| bbox(c)).collect();
-        for (i, (_, c)) in new.iter().enumerate() {
-            for (_, d) in &new[..i] {
-                if !tri_tri(c, d).is_legal() {
+        for (i, (ci, c)) in new.iter().enumerate() {
+            for (di, d) in &new[..i] {
+                if meet_improperly(c, *ci, d, *di) {
                     return true;
                 }
             }
@@ -548,11 +548,11 @@ impl<'a> Remesher<'a> {
             }
             let d = self.corners(u);
             let (dlo, dhi) = bbox(&d);
-            for ((_, c), (lo, hi)) in new.iter().zip(&boxes) {
+            for ((ci, c), (lo, hi)) in new.iter().zip(&boxes) {
                 if (0..3).any(|k| dlo[k] > hi[k] || dhi[k] < lo[k]) {
                     continue;
                 }
-                if !tri_tri(c, &d).is_legal() {
+                if meet_improperly(c, *ci, &d, self.tris[u as usize]) {
                     return true;
                 }
             }
