@@ -191,6 +191,13 @@ pub fn mesh_from(
     labels: &Ints1<'_>,
 ) -> PyResult<TetMesh> {
     let pts = points_from(points)?;
+    // As the file readers refuse them: no measure or move means anything at such a point.
+    if let Some(i) = pts.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+        return Err(PyValueError::new_err(format!(
+            "points: point {i} has a non-finite coordinate {:?}",
+            pts[i]
+        )));
+    }
     let mut t = indices_from::<4>("tets", tets, pts.len())?;
     biotet_io::orient_tets(&pts, &mut t);
     let n = labels.shape()[0];

@@ -8,7 +8,9 @@ from pathlib import Path
 
 import biotet
 from biotet import _core
-from conftest import cube
+import pytest
+
+from conftest import SHAPES, cube
 
 
 def test_every_public_name_has_a_docstring():
@@ -47,3 +49,24 @@ def test_nothing_printed_and_progress_logged(capfd, caplog):
     caplog.clear()
     biotet.mesh(p, t, size=0.6)  # the logger below INFO: nothing logged
     assert not [r for r in caplog.records if r.name == "biotet"]
+
+
+def test_meshes_and_surfaces_compare_as_plain_bools():
+    # Until session 33, `a == b` raised numpy's "truth value of an array is ambiguous".
+    a = biotet.mesh(*cube())
+    b = biotet.mesh(*cube())
+    assert a == b and not (a != b)
+    moved = biotet.TetMesh(a.points + 1.0, a.tets, a.labels)
+    assert a != moved
+    assert a != biotet.TetMesh(a.points, a.tets[:1], a.labels[:1])
+    assert a != "a mesh"
+    s = biotet.read_surface(SHAPES / "tm_box.off")
+    assert s == biotet.read_surface(SHAPES / "tm_box.off")
+    assert s != biotet.Surface(s.points * 2, s.triangles, s.sides)
+    with pytest.raises(TypeError):
+        hash(a)
+
+
+def test_mesh_file_with_no_file_is_a_value_error():
+    with pytest.raises(ValueError, match="at least one file"):
+        biotet.mesh_file([])

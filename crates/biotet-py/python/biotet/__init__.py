@@ -189,7 +189,12 @@ def _labels(a: Any, n: int) -> np.ndarray:
     return x
 
 
-@dataclass
+def _same_arrays(a: Any, b: Any, names: Sequence[str]) -> bool:
+    """Whether ``a`` and ``b`` hold equal arrays under ``names`` (shapes and values)."""
+    return all(np.array_equal(getattr(a, n), getattr(b, n)) for n in names)
+
+
+@dataclass(eq=False)
 class Surface:
     """A triangle surface: ``points`` (n×3 float64), ``triangles`` (m×3 int32) and ``sides``
     (m×2 int32: the region behind and in front of each triangle, ``[1, 0]`` for a plain closed
@@ -199,8 +204,17 @@ class Surface:
     triangles: np.ndarray
     sides: np.ndarray
 
+    def __eq__(self, other: object) -> Any:
+        """Equal when the points, triangles and sides are (a plain ``bool``; numpy's
+        elementwise ``==`` made the dataclass comparison raise)."""
+        if not isinstance(other, Surface):
+            return NotImplemented
+        return _same_arrays(self, other, ("points", "triangles", "sides"))
 
-@dataclass
+    __hash__ = None  # type: ignore[assignment]
+
+
+@dataclass(eq=False)
 class TetMesh:
     """A tetrahedral mesh: ``points`` (n×3 float64), ``tets`` (m×4 int32, positively oriented),
     ``labels`` (m int32, the region of each tet) and ``report`` (the dict ``biotet mesh --json``
@@ -210,6 +224,15 @@ class TetMesh:
     tets: np.ndarray
     labels: np.ndarray
     report: dict = field(default_factory=dict)
+
+    def __eq__(self, other: object) -> Any:
+        """Equal when the points, tets and labels are (the report, with its timings, is not
+        compared)."""
+        if not isinstance(other, TetMesh):
+            return NotImplemented
+        return _same_arrays(self, other, ("points", "tets", "labels"))
+
+    __hash__ = None  # type: ignore[assignment]
 
     @property
     def n_points(self) -> int:
@@ -638,6 +661,8 @@ def mesh_file(
     if isinstance(paths, (str, os.PathLike)):
         paths = [paths]
     ps = [os.fspath(p) for p in paths]
+    if not ps:
+        raise ValueError("mesh_file needs at least one file")
     per_file: list[list[int] | None] = [None] * len(ps)
     for key, ls in (labels or {}).items():
         hits = [i for i, p in enumerate(ps) if p == key or os.path.basename(p) == key]
