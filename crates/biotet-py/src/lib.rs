@@ -277,7 +277,10 @@ fn mesh_with(
     };
     let clock = std::time::Instant::now();
     let spec = match (o.size, field) {
-        (Some(h), _) => SizeSpec::Uniform(h),
+        (Some(h), _) => SizeSpec::UpTo {
+            size: h,
+            grading: o.grading,
+        },
         (None, Some(field)) => {
             let (grid, what) = match field {
                 SizeField::File(path, array) => (

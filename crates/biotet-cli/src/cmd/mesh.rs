@@ -68,7 +68,8 @@ pub struct Args {
     /// output as OUT.failed.EXT for inspection (OUT itself is never written by a failed run).
     #[arg(long, requires = "output")]
     keep_failed: bool,
-    /// Uniform desired edge length everywhere.
+    /// Desired edge length in the volume; near the surface no coarser than the surface's own
+    /// edges, growing away from them by --grading up to H (a finer H is uniform).
     #[arg(long, value_name = "H")]
     size: Option<f64>,
     /// Size from the surface (the default): at each surface node the mean length of its edges,
@@ -257,7 +258,10 @@ pub fn run(a: Args) -> Result<ExitCode> {
 
     let clock = Instant::now();
     let spec = match (a.size, &a.size_field) {
-        (Some(h), _) => SizeSpec::Uniform(h),
+        (Some(h), _) => SizeSpec::UpTo {
+            size: h,
+            grading: a.grading,
+        },
         (None, Some(path)) => {
             let grid = biotet_io::read_scalar_grid_named(path, a.size_field_array.as_deref())?;
             // An oblique image is meshed in its frame: the field is looked up in world.

@@ -488,7 +488,8 @@ def mesh(
     or 1, 2, ... by nesting. Or give ``side_labels`` (m×2: the region behind and in front of
     each triangle) for a multi-material surface.
 
-    Sizes: ``size`` (uniform), else ``size_field`` (a .vti or NIfTI file, with
+    Sizes: ``size`` (as ``--size``: uniform where it is no coarser than the surface's median
+    edge, else graded up to it from the surface's edges), else ``size_field`` (a .vti or NIfTI file, with
     ``size_field_array`` naming a .vti array, or a :class:`SizeField`; as ``--size-field``), else
     from the surface's own edges growing by ``grading`` per unit distance; all clamped to
     ``min_size``/``max_size``. ``region_sizes`` maps a region label to a uniform size inside it
@@ -569,7 +570,8 @@ def mesh_image(
     ``outside`` (``--outside``: the value of the outside), ``min_component_voxels``
     (``--min-component-voxels``: smaller 6-connected islands join the label around them).
 
-    Sizes: ``size`` (uniform), else ``size_field`` (a .vti or NIfTI file, with
+    Sizes: ``size`` (as ``--size``: uniform where it is no coarser than the surface's median
+    edge, else graded up to it from the surface's edges), else ``size_field`` (a .vti or NIfTI file, with
     ``size_field_array`` naming a .vti array, or a :class:`SizeField`; as ``--size-field``), else
     from the surface's own edges growing by ``grading`` per unit distance; all clamped to
     ``min_size``/``max_size``. ``region_sizes`` maps a region label to a uniform size inside it
@@ -641,7 +643,8 @@ def mesh_file(
     remeshed within half the smallest voxel spacing unless ``surface_tolerance`` is given or
     ``exact_surface=True``).
 
-    Sizes: ``size`` (uniform), else ``size_field`` (a .vti or NIfTI file, with
+    Sizes: ``size`` (as ``--size``: uniform where it is no coarser than the surface's median
+    edge, else graded up to it from the surface's edges), else ``size_field`` (a .vti or NIfTI file, with
     ``size_field_array`` naming a .vti array, or a :class:`SizeField`; as ``--size-field``), else
     from the surface's own edges growing by ``grading`` per unit distance; all clamped to
     ``min_size``/``max_size``. ``region_sizes`` maps a region label to a uniform size inside it

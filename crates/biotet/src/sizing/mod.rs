@@ -27,6 +27,17 @@ use crate::mesh::surface::SurfaceMesh;
 pub enum SizeSpec {
     /// The same size everywhere.
     Uniform(f64),
+    /// `size` in the volume, but near the surface no coarser than the surface's own edges,
+    /// growing away from them by `grading` (as [`SizeSpec::FromSurface`] capped at `size`): the
+    /// surface is kept exactly, so a node spacing coarser than its triangles only leaves flat
+    /// tets on them (gmsh extends its boundary sizes into the volume the same way). Where the
+    /// surface's edges are longer than `size`, this is `Uniform(size)`.
+    UpTo {
+        /// The size in the volume.
+        size: f64,
+        /// Growth of the size per unit distance from the surface.
+        grading: f64,
+    },
     /// From the surface's edge lengths, graded away from it.
     FromSurface {
         /// Growth of the size per unit distance from the surface (0 keeps the smallest size).
@@ -79,6 +90,9 @@ impl std::fmt::Debug for SizeSpec {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             SizeSpec::Uniform(h) => write!(f, "Uniform({h})"),
+            SizeSpec::UpTo { size, grading } => {
+                write!(f, "UpTo {{ size: {size}, grading: {grading} }}")
+            }
             SizeSpec::FromSurface { grading } => write!(f, "FromSurface {{ grading: {grading} }}"),
             SizeSpec::Field { min, max, .. } => write!(f, "Field {{ min: {min}, max: {max} }}"),
         }
@@ -208,7 +222,7 @@ fn positive(what: &str, value: f64) -> Result<f64, SizingError> {
 impl Sizing {
     /// Build the sizing function for `surface` (used by [`SizeSpec::FromSurface`] only).
     pub fn new(surface: &SurfaceMesh, opts: SizingOptions) -> Result<Sizing, SizingError> {
-        let max = match opts.max_size {
+        let mut max = match opts.max_size {
             Some(m) => positive("maximum size", m)?,
             None => f64::INFINITY,
         };
@@ -217,19 +231,22 @@ impl Sizing {
                 let h = positive("size", h)?;
                 (Base::Uniform(h), h)
             }
+            SizeSpec::UpTo { size, grading } if !surface.triangles.is_empty() => {
+                let h = positive("size", size)?;
+                max = max.min(h);
+                // Not below the median surface size: an H at or under it stays uniform, and the
+                // few short edges of a marching-cubes surface do not pull the size under H.
+                let floor = |median: f64| opts.min_size.unwrap_or(median.min(h));
+                let (field, median) = surface_field(surface, grading, floor, max)?;
+                (Base::Surface(field), median.min(h))
+            }
+            SizeSpec::UpTo { size, .. } => {
+                let h = positive("size", size)?;
+                (Base::Uniform(h), h)
+            }
             SizeSpec::FromSurface { grading } => {
-                if !(grading >= 0.0 && grading.is_finite()) {
-                    return Err(SizingError::NotPositive {
-                        what: "grading".into(),
-                        value: grading,
-                    });
-                }
-                let (nodes, h) = node_sizes(surface)?;
-                let mut sorted = h.clone();
-                sorted.sort_by(f64::total_cmp);
-                let median = sorted[sorted.len() / 2];
-                let lo = opts.min_size.unwrap_or(0.5 * median);
-                let field = SurfaceField::new(nodes, h, grading, lo, max);
+                let floor = |median: f64| opts.min_size.unwrap_or(0.5 * median);
+                let (field, median) = surface_field(surface, grading, floor, max)?;
                 (Base::Surface(field), 0.5 * median)
             }
             SizeSpec::Field {
@@ -312,6 +329,28 @@ impl Sizing {
     pub fn bounds(&self) -> (f64, f64) {
         (self.min, self.max)
     }
+}
+
+/// The surface-derived field of [`SizeSpec::FromSurface`]: at most `max`, at least
+/// `floor(median node size)`; with the median.
+fn surface_field(
+    surface: &SurfaceMesh,
+    grading: f64,
+    floor: impl FnOnce(f64) -> f64,
+    max: f64,
+) -> Result<(SurfaceField, f64), SizingError> {
+    if !(grading >= 0.0 && grading.is_finite()) {
+        return Err(SizingError::NotPositive {
+            what: "grading".into(),
+            value: grading,
+        });
+    }
+    let (nodes, h) = node_sizes(surface)?;
+    let mut sorted = h.clone();
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted[sorted.len() / 2];
+    let lo = floor(median).min(max);
+    Ok((SurfaceField::new(nodes, h, grading, lo, max), median))
 }
 
 /// Mean length of the edges at each referenced surface node, capped at half the local thickness
