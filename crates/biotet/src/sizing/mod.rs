@@ -31,7 +31,7 @@ pub enum SizeSpec {
     /// growing away from them by `grading` (as [`SizeSpec::FromSurface`] capped at `size`): the
     /// surface is kept exactly, so a node spacing coarser than its triangles only leaves flat
     /// tets on them (gmsh extends its boundary sizes into the volume the same way). Where the
-    /// surface's edges are longer than `size`, this is `Uniform(size)`.
+    /// median surface node size is `size` or more, this is `Uniform(size)`.
     UpTo {
         /// The size in the volume.
         size: f64,
@@ -220,7 +220,8 @@ fn positive(what: &str, value: f64) -> Result<f64, SizingError> {
 }
 
 impl Sizing {
-    /// Build the sizing function for `surface` (used by [`SizeSpec::FromSurface`] only).
+    /// Build the sizing function for `surface` (used by [`SizeSpec::FromSurface`] and
+    /// [`SizeSpec::UpTo`] only).
     pub fn new(surface: &SurfaceMesh, opts: SizingOptions) -> Result<Sizing, SizingError> {
         let mut max = match opts.max_size {
             Some(m) => positive("maximum size", m)?,
@@ -233,12 +234,16 @@ impl Sizing {
             }
             SizeSpec::UpTo { size, grading } if !surface.triangles.is_empty() => {
                 let h = positive("size", size)?;
-                max = max.min(h);
                 // Not below the median surface size: an H at or under it stays uniform, and the
                 // few short edges of a marching-cubes surface do not pull the size under H.
                 let floor = |median: f64| opts.min_size.unwrap_or(median.min(h));
-                let (field, median) = surface_field(surface, grading, floor, max)?;
-                (Base::Surface(field), median.min(h))
+                let (field, median) = surface_field(surface, grading, floor, max.min(h))?;
+                if median >= h && opts.min_size.is_none() {
+                    (Base::Uniform(h), h)
+                } else {
+                    max = max.min(h);
+                    (Base::Surface(field), median.min(h))
+                }
             }
             SizeSpec::UpTo { size, .. } => {
                 let h = positive("size", size)?;
