@@ -27,6 +27,7 @@ pub mod sizing_grid;
 pub mod smooth;
 pub mod surface;
 pub mod template;
+pub mod text;
 
 pub use mesh::surface::SurfaceMesh;
 pub use mesh::tet::{NO_NEIGHBOR, TET_FACES, TetMesh};

@@ -52,12 +52,17 @@ pub enum Zone {
 
 impl std::fmt::Display for Zone {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let p = |x: &P3| format!("({}, {}, {})", x[0], x[1], x[2]);
+        use crate::text::{point as p, short};
         match self {
             Zone::Region(r) => write!(f, "region {r}"),
             Zone::Box { lo, hi } => write!(f, "the box from {} to {}", p(lo), p(hi)),
             Zone::Sphere { centre, radius } => {
-                write!(f, "the ball of radius {radius} around {}", p(centre))
+                write!(
+                    f,
+                    "the ball of radius {} around {}",
+                    short(*radius),
+                    p(centre)
+                )
             }
         }
     }

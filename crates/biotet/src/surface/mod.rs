@@ -38,6 +38,7 @@ use std::time::Instant;
 use crate::geom::vec3::volume6;
 use crate::mesh::surface::SurfaceMesh;
 use crate::mesh::validate::{self, ValidateOptions, validate_surface};
+use crate::text::short;
 use bvh::PatchIndex;
 use features::Features;
 use rustc_hash::{FxHashMap, FxHashSet};
@@ -211,9 +212,9 @@ pub enum SurfaceError {
     #[error(
         "surface stage: cannot keep the surface within {}: measured {} from input to output and \
          {} from output to input (try a larger tolerance or a smaller edge length)",
-        short(.tolerance),
-        short(.in_to_out),
-        short(.out_to_in)
+        short(*.tolerance),
+        short(*.in_to_out),
+        short(*.out_to_in)
     )]
     Tolerance {
         /// `D`.
@@ -223,13 +224,6 @@ pub enum SurfaceError {
         /// Measured output → input.
         out_to_in: f64,
     },
-}
-
-/// `x` as Rust writes it, or in scientific notation where that is long (a tolerance of 1e-300
-/// came out as 300 zeros).
-fn short(x: &f64) -> String {
-    let s = format!("{x}");
-    if s.len() > 20 { format!("{x:.4e}") } else { s }
 }
 
 /// The median edge length of a surface.
@@ -382,10 +376,7 @@ pub fn improve_with_progress(
         }
         retries += 1;
         w *= RETRY_SCALE;
-        progress(&format!(
-            "again, within {} of the tolerance",
-            short(&(w / d))
-        ));
+        progress(&format!("again, within {} of the tolerance", short(w / d)));
     };
     let [seconds_remesh, seconds_measure] = seconds;
     let Run {
