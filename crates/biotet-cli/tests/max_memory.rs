@@ -99,3 +99,45 @@ fn bad_limits_are_refused() {
         assert!(msg.contains("--max-memory"), "{v}: {msg}");
     }
 }
+
+/// The surface stage at a fine edge length (a label image's default, or `--surface-tolerance`
+/// with `--size`) grew past 2 GB under `--max-memory 300M` and ran on (an image of 30³ 1 mm
+/// voxels at `--size 0.02`): refused before the work, naming the stage and the option.
+#[test]
+fn a_surface_stage_estimated_above_the_limit_is_refused_before_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("m.vtu");
+    let box_ = root().join("tests/data/shapes/tm_box.off");
+    for args in [
+        vec![
+            "mesh",
+            s(&box_),
+            "--surface-tolerance",
+            "0.01",
+            "--size",
+            "0.001",
+        ],
+        vec![
+            "surface",
+            "improve",
+            s(&box_),
+            "--tolerance",
+            "0.01",
+            "--edge-length",
+            "0.001",
+        ],
+    ] {
+        let mut args = args;
+        args.extend(["--max-memory", "64M", "-o", s(&out)]);
+        let (code, msg) = code_and_message(&args);
+        assert_eq!(code, Some(2), "{msg}");
+        assert!(
+            msg.contains("tm_box.off")
+                && msg.contains("surface stage")
+                && msg.contains("--max-memory"),
+            "{msg}"
+        );
+        assert_eq!(msg.trim_end().lines().count(), 1, "{msg}");
+        assert!(!out.exists());
+    }
+}

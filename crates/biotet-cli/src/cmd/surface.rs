@@ -117,6 +117,45 @@ pub fn run(a: Args) -> Result<ExitCode> {
     }
 }
 
+/// Bytes the stage holds per output triangle, generously (points, triangles, their incidence,
+/// bounds and sample covers, the crossing grid; then the output and its measure).
+const BYTES_PER_TRIANGLE: f64 = 1024.0;
+
+/// Refuse, before any work, a target edge length `l` whose remeshed surface would need more
+/// memory than `--max-memory` (an image at `--size 0.02` with 1 mm voxels grew past 2 GB and ran
+/// on, where meshing at that size is refused at once).
+fn refuse_over_limit(surface: &SurfaceMesh, l: f64) -> Result<()> {
+    let area: f64 = (0..surface.triangles.len())
+        .map(|t| {
+            let [a, b, c] = surface.corners(t);
+            let u = [0, 1, 2].map(|k| b[k] - a[k]);
+            let v = [0, 1, 2].map(|k| c[k] - a[k]);
+            let n = [
+                u[1] * v[2] - u[2] * v[1],
+                u[2] * v[0] - u[0] * v[2],
+                u[0] * v[1] - u[1] * v[0],
+            ];
+            0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
+        })
+        .sum();
+    // Equilateral triangles of edge l.
+    let triangles = area / (0.25 * 3f64.sqrt() * l * l);
+    let bytes = triangles * BYTES_PER_TRIANGLE;
+    let limit = biotet_io::limits::max_memory();
+    if bytes > limit as f64 {
+        anyhow::bail!(
+            "the surface stage at edge length {} needs about {} of memory (about {:.0} \
+             triangles), more than the limit of {} (--max-memory); give a larger size or a \
+             larger limit",
+            biotet::text::short(l),
+            biotet_io::limits::human(bytes.min(u64::MAX as f64) as u64),
+            triangles,
+            biotet_io::limits::human(limit)
+        );
+    }
+    Ok(())
+}
+
 /// The stage with the CLI's options.
 pub fn stage(
     surface: &SurfaceMesh,
@@ -126,6 +165,9 @@ pub fn stage(
     orient_sheets: bool,
     progress: &Stage,
 ) -> Result<(SurfaceMesh, SurfaceReport)> {
+    if let Some(l) = edge_length {
+        refuse_over_limit(surface, l)?;
+    }
     let opts = SurfaceOptions {
         tolerance,
         edge_length,
