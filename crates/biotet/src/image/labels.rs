@@ -64,6 +64,35 @@ pub enum LabelError {
     /// No region left.
     #[error("no region: every voxel is outside (value {0})")]
     Empty(u32),
+    /// `--labels` kept none of the image's labels.
+    #[error("--labels {asked}: no voxel has one of these labels (the image's: {present})")]
+    NothingKept {
+        /// The labels asked for.
+        asked: String,
+        /// The image's region labels (after merging).
+        present: String,
+    },
+    /// `--min-component-voxels` merged every region away (each of its components was smaller:
+    /// a checkerboard of single voxels).
+    #[error(
+        "--min-component-voxels {0}: every region's components are smaller than that, so none \
+         is left; give a smaller number"
+    )]
+    IslandsTookAll(usize),
+}
+
+/// Labels as `a, b, c` (the first 20, then how many more).
+fn label_list(labels: impl IntoIterator<Item = u32>) -> String {
+    let all: Vec<u32> = labels.into_iter().collect();
+    let mut s: Vec<String> = all.iter().take(20).map(|l| l.to_string()).collect();
+    if all.len() > 20 {
+        s.push(format!("and {} more", all.len() - 20));
+    }
+    if s.is_empty() {
+        "none".into()
+    } else {
+        s.join(", ")
+    }
 }
 
 /// Apply the options to an image in place.
@@ -80,23 +109,38 @@ pub fn apply(img: &mut LabelImage, opts: &LabelOptions) -> Result<LabelReport, L
         opts.keep.as_ref().map(|k| k.iter().copied().collect());
     let mut zeros = 0usize;
     let mut dropped = 0usize;
+    // The region labels the merges leave, before `keep` (for its message).
+    let mut present: rustc_hash::FxHashSet<u32> = rustc_hash::FxHashSet::default();
     for l in img.labels.iter_mut() {
         let mut v = map.get(l).copied().unwrap_or(*l);
         if v == opts.outside {
             v = 0;
         } else if v == 0 {
             zeros += 1;
-        } else if let Some(k) = &keep
-            && !k.contains(&v)
-        {
-            v = 0;
-            dropped += 1;
+        } else if let Some(k) = &keep {
+            present.insert(v);
+            if !k.contains(&v) {
+                v = 0;
+                dropped += 1;
+            }
         }
         *l = v;
     }
     if zeros > 0 {
         return Err(LabelError::ZeroNotOutside(zeros, opts.outside));
     }
+    if let Some(k) = &opts.keep
+        && !present.is_empty()
+        && !k.iter().any(|l| present.contains(l))
+    {
+        let mut present: Vec<u32> = present.into_iter().collect();
+        present.sort_unstable();
+        return Err(LabelError::NothingKept {
+            asked: label_list(k.iter().copied()),
+            present: label_list(present),
+        });
+    }
+    let any_region = img.labels.iter().any(|&l| l != 0);
     let islands = if opts.min_component_voxels > 0 {
         merge_islands(img, opts.min_component_voxels)
     } else {
@@ -104,7 +148,11 @@ pub fn apply(img: &mut LabelImage, opts: &LabelOptions) -> Result<LabelReport, L
     };
     let regions: Vec<(u32, usize)> = img.counts().into_iter().filter(|c| c.0 != 0).collect();
     if regions.is_empty() {
-        return Err(LabelError::Empty(opts.outside));
+        return Err(if any_region {
+            LabelError::IslandsTookAll(opts.min_component_voxels)
+        } else {
+            LabelError::Empty(opts.outside)
+        });
     }
     let comps = Components::of(img);
     let mut per: FxHashMap<u32, usize> = FxHashMap::default();
@@ -369,6 +417,36 @@ mod tests {
             ..Default::default()
         };
         assert_eq!(apply(&mut z, &o), Err(LabelError::ZeroNotOutside(1, 5)));
+    }
+
+    /// Until session 33 both said "no region: every voxel is outside (value 0)", which named
+    /// neither the option nor the cause.
+    #[test]
+    fn an_empty_result_names_the_option_that_emptied_it() {
+        let mut m = img([4, 1, 1], vec![0, 1, 2, 3]);
+        let keep = LabelOptions {
+            keep: Some(vec![42]),
+            ..Default::default()
+        };
+        assert_eq!(
+            apply(&mut m, &keep).unwrap_err().to_string(),
+            "--labels 42: no voxel has one of these labels (the image's: 1, 2, 3)"
+        );
+        // A checkerboard of single voxels inside the outside: every component is an island.
+        let mut c = img(
+            [4, 4, 1],
+            vec![0, 0, 0, 0, 0, 1, 2, 0, 0, 2, 1, 0, 0, 0, 0, 0],
+        );
+        let islands = LabelOptions {
+            min_component_voxels: 2,
+            ..Default::default()
+        };
+        assert_eq!(apply(&mut c, &islands), Err(LabelError::IslandsTookAll(2)));
+        let mut e = img([2, 1, 1], vec![0, 0]);
+        assert_eq!(
+            apply(&mut e, &LabelOptions::default()),
+            Err(LabelError::Empty(0))
+        );
     }
 
     #[test]
