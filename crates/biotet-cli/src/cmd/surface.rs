@@ -125,17 +125,11 @@ const BYTES_PER_TRIANGLE: f64 = 1024.0;
 /// memory than `--max-memory` (an image at `--size 0.02` with 1 mm voxels grew past 2 GB and ran
 /// on, where meshing at that size is refused at once).
 fn refuse_over_limit(surface: &SurfaceMesh, l: f64) -> Result<()> {
+    use biotet::geom::vec3::{cross, norm, sub};
     let area: f64 = (0..surface.triangles.len())
         .map(|t| {
             let [a, b, c] = surface.corners(t);
-            let u = [0, 1, 2].map(|k| b[k] - a[k]);
-            let v = [0, 1, 2].map(|k| c[k] - a[k]);
-            let n = [
-                u[1] * v[2] - u[2] * v[1],
-                u[2] * v[0] - u[0] * v[2],
-                u[0] * v[1] - u[1] * v[0],
-            ];
-            0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
+            0.5 * norm(cross(sub(b, a), sub(c, a)))
         })
         .sum();
     // Equilateral triangles of edge l.

@@ -103,14 +103,6 @@ pub fn meet_improperly(t: &[P3; 3], ti: [u32; 3], u: &[P3; 3], ui: [u32; 3]) -> 
     }
 }
 
-impl TriTri {
-    /// Whether this is a legal contact for two triangles of a surface: disjoint, or sharing a
-    /// vertex or an edge and nothing more.
-    pub fn is_legal(self) -> bool {
-        self != TriTri::Improper
-    }
-}
-
 /// Drop coordinate `axis`, keeping the other two in cyclic order.
 #[inline]
 pub fn drop_axis(p: P3, axis: usize) -> P2 {

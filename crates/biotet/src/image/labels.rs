@@ -81,20 +81,6 @@ pub enum LabelError {
     IslandsTookAll(usize),
 }
 
-/// Labels as `a, b, c` (the first 20, then how many more).
-fn label_list(labels: impl IntoIterator<Item = u32>) -> String {
-    let all: Vec<u32> = labels.into_iter().collect();
-    let mut s: Vec<String> = all.iter().take(20).map(|l| l.to_string()).collect();
-    if all.len() > 20 {
-        s.push(format!("and {} more", all.len() - 20));
-    }
-    if s.is_empty() {
-        "none".into()
-    } else {
-        s.join(", ")
-    }
-}
-
 /// Apply the options to an image in place.
 pub fn apply(img: &mut LabelImage, opts: &LabelOptions) -> Result<LabelReport, LabelError> {
     let mut map: FxHashMap<u32, u32> = FxHashMap::default();
@@ -109,8 +95,11 @@ pub fn apply(img: &mut LabelImage, opts: &LabelOptions) -> Result<LabelReport, L
         opts.keep.as_ref().map(|k| k.iter().copied().collect());
     let mut zeros = 0usize;
     let mut dropped = 0usize;
-    // The region labels the merges leave, before `keep` (for its message).
-    let mut present: rustc_hash::FxHashSet<u32> = rustc_hash::FxHashSet::default();
+    // The labels `keep` dropped, for its message should it keep none (a set insert only where
+    // the dropped value changes along the voxels).
+    let mut dropped_labels: rustc_hash::FxHashSet<u32> = rustc_hash::FxHashSet::default();
+    let mut last_dropped = None;
+    let mut kept_any = false;
     for l in img.labels.iter_mut() {
         let mut v = map.get(l).copied().unwrap_or(*l);
         if v == opts.outside {
@@ -118,8 +107,13 @@ pub fn apply(img: &mut LabelImage, opts: &LabelOptions) -> Result<LabelReport, L
         } else if v == 0 {
             zeros += 1;
         } else if let Some(k) = &keep {
-            present.insert(v);
-            if !k.contains(&v) {
+            if k.contains(&v) {
+                kept_any = true;
+            } else {
+                if last_dropped != Some(v) {
+                    dropped_labels.insert(v);
+                    last_dropped = Some(v);
+                }
                 v = 0;
                 dropped += 1;
             }
@@ -130,14 +124,14 @@ pub fn apply(img: &mut LabelImage, opts: &LabelOptions) -> Result<LabelReport, L
         return Err(LabelError::ZeroNotOutside(zeros, opts.outside));
     }
     if let Some(k) = &opts.keep
-        && !present.is_empty()
-        && !k.iter().any(|l| present.contains(l))
+        && !kept_any
+        && dropped > 0
     {
-        let mut present: Vec<u32> = present.into_iter().collect();
+        let mut present: Vec<u32> = dropped_labels.into_iter().collect();
         present.sort_unstable();
         return Err(LabelError::NothingKept {
-            asked: label_list(k.iter().copied()),
-            present: label_list(present),
+            asked: crate::text::labels(k.iter().copied()),
+            present: crate::text::labels(present),
         });
     }
     let any_region = img.labels.iter().any(|&l| l != 0);

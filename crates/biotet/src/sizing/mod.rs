@@ -184,11 +184,7 @@ pub fn check_region_labels(
         None => Ok(()),
         Some(&(label, _)) => Err(SizingError::NoRegion {
             label,
-            regions: labels
-                .iter()
-                .map(|l| l.to_string())
-                .collect::<Vec<_>>()
-                .join(", "),
+            regions: crate::text::labels(labels),
         }),
     }
 }
@@ -234,15 +230,16 @@ impl Sizing {
             }
             SizeSpec::UpTo { size, grading } if !surface.triangles.is_empty() => {
                 let h = positive("size", size)?;
-                // Not below the median surface size: an H at or under it stays uniform, and the
-                // few short edges of a marching-cubes surface do not pull the size under H.
-                let floor = |median: f64| opts.min_size.unwrap_or(median.min(h));
-                let (field, median) = surface_field(surface, grading, floor, max.min(h))?;
-                if median >= h && opts.min_size.is_none() {
+                let sizes = SurfaceSizes::of(surface, grading)?;
+                if sizes.median >= h && opts.min_size.is_none() {
                     (Base::Uniform(h), h)
                 } else {
+                    // Not below the median surface size: the few short edges of a
+                    // marching-cubes surface do not pull the size under H.
                     max = max.min(h);
-                    (Base::Surface(field), median.min(h))
+                    let lo = opts.min_size.unwrap_or(sizes.median.min(h));
+                    let median = sizes.median;
+                    (Base::Surface(sizes.field(lo, max)), median.min(h))
                 }
             }
             SizeSpec::UpTo { size, .. } => {
@@ -250,9 +247,10 @@ impl Sizing {
                 (Base::Uniform(h), h)
             }
             SizeSpec::FromSurface { grading } => {
-                let floor = |median: f64| opts.min_size.unwrap_or(0.5 * median);
-                let (field, median) = surface_field(surface, grading, floor, max)?;
-                (Base::Surface(field), 0.5 * median)
+                let sizes = SurfaceSizes::of(surface, grading)?;
+                let half = 0.5 * sizes.median;
+                let lo = opts.min_size.unwrap_or(half);
+                (Base::Surface(sizes.field(lo, max)), half)
             }
             SizeSpec::Field {
                 size,
@@ -336,26 +334,38 @@ impl Sizing {
     }
 }
 
-/// The surface-derived field of [`SizeSpec::FromSurface`]: at most `max`, at least
-/// `floor(median node size)`; with the median.
-fn surface_field(
-    surface: &SurfaceMesh,
+/// The node sizes of the surface-derived field ([`node_sizes`]), their median and the grading.
+struct SurfaceSizes {
+    nodes: Vec<[f64; 3]>,
+    h: Vec<f64>,
+    median: f64,
     grading: f64,
-    floor: impl FnOnce(f64) -> f64,
-    max: f64,
-) -> Result<(SurfaceField, f64), SizingError> {
-    if !(grading >= 0.0 && grading.is_finite()) {
-        return Err(SizingError::NotPositive {
-            what: "grading".into(),
-            value: grading,
-        });
+}
+
+impl SurfaceSizes {
+    fn of(surface: &SurfaceMesh, grading: f64) -> Result<SurfaceSizes, SizingError> {
+        if !(grading >= 0.0 && grading.is_finite()) {
+            return Err(SizingError::NotPositive {
+                what: "grading".into(),
+                value: grading,
+            });
+        }
+        let (nodes, h) = node_sizes(surface)?;
+        let mut sorted = h.clone();
+        sorted.sort_by(f64::total_cmp);
+        let median = sorted[sorted.len() / 2];
+        Ok(SurfaceSizes {
+            nodes,
+            h,
+            median,
+            grading,
+        })
     }
-    let (nodes, h) = node_sizes(surface)?;
-    let mut sorted = h.clone();
-    sorted.sort_by(f64::total_cmp);
-    let median = sorted[sorted.len() / 2];
-    let lo = floor(median).min(max);
-    Ok((SurfaceField::new(nodes, h, grading, lo, max), median))
+
+    /// The graded field, between `lo` (at most `max`) and `max`.
+    fn field(self, lo: f64, max: f64) -> SurfaceField {
+        SurfaceField::new(self.nodes, self.h, self.grading, lo.min(max), max)
+    }
 }
 
 /// Mean length of the edges at each referenced surface node, capped at half the local thickness

@@ -251,6 +251,14 @@ pub fn dist2(a: P3, b: P3) -> f64 {
     dot(d, d)
 }
 
+/// The length of the longest edge of triangle `c`.
+pub fn longest_edge(c: &[P3; 3]) -> f64 {
+    (0..3)
+        .map(|k| dist2(c[k], c[(k + 1) % 3]))
+        .fold(0.0, f64::max)
+        .sqrt()
+}
+
 /// The squared distance from `p` to the box `lo..hi` (0 inside).
 pub(super) fn box_d2(p: P3, lo: P3, hi: P3) -> f64 {
     let mut s = 0.0;

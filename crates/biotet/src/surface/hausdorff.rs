@@ -19,7 +19,7 @@
 
 use rayon::prelude::*;
 
-use super::bvh::{Bvh, Hint, PatchIndex, closest_on_triangle, dist2};
+use super::bvh::{Bvh, Hint, PatchIndex, closest_on_triangle, dist2, longest_edge};
 use crate::geom::vec3::{cross, norm, sub};
 
 type P3 = [f64; 3];
@@ -213,14 +213,6 @@ impl Probe<'_> {
         self.grid(&p, n, Some(r), &mut grid);
         self.cells(&p, n, &grid, limit, fine, budget)
     }
-}
-
-/// The length of the longest edge of `c`.
-fn longest_edge(c: &[P3; 3]) -> f64 {
-    (0..3)
-        .map(|k| dist2(c[k], c[(k + 1) % 3]))
-        .fold(0.0, f64::max)
-        .sqrt()
 }
 
 /// The place of grid point `(i, j)` of an `n`-step grid, row by row (row `i` holds `n + 1 - i`

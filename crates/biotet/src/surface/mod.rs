@@ -15,8 +15,8 @@
 //!    self-intersection test), and the measure of the two-sided distance with dense samples
 //!    ([`hausdorff::one_sided`] both ways); where it finds the output beyond `D`, or cannot
 //!    prove it within, the repair: the output triangles there are refined (the longest edge
-//!    split, the new point projected onto the input) and the output validated and measured again (at most
-//!    four times, `REPAIRS`);
+//!    split, the new point projected onto the input) and the output validated and measured
+//!    again (at most four times, `REPAIRS`);
 //! 4. if the distance still exceeds `D`, steps 2–3 run again with their working tolerances
 //!    scaled down (at most twice, `RETRIES`); the stage fails with [`SurfaceError::Tolerance`]
 //!    only if that does not bring it within `D` either.

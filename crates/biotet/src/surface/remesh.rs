@@ -27,8 +27,8 @@
 use rustc_hash::{FxHashMap, FxHashSet};
 
 use super::bvh::{
-    Hint, PatchIndex, closest_on_segment, closest_on_triangle, dist2, unit_normal, within,
-    within_d2,
+    Hint, PatchIndex, closest_on_segment, closest_on_triangle, dist2, longest_edge, unit_normal,
+    within, within_d2,
 };
 use super::features::{Features, key};
 use super::grid::Grid;
@@ -359,11 +359,7 @@ impl<'a> Remesher<'a> {
 
     /// The samples of triangle `c` per edge ([`Self::near_input`]).
     fn sample_count(&self, c: &[P3; 3]) -> u8 {
-        let longest = (0..3)
-            .map(|k| dist2(c[k], c[(k + 1) % 3]))
-            .fold(0.0, f64::max)
-            .sqrt();
-        ((longest / self.spacing).ceil() as usize).clamp(2, 6) as u8
+        ((longest_edge(c) / self.spacing).ceil() as usize).clamp(2, 6) as u8
     }
 
     /// Whether every sample of triangle `c` (a barycentric grid of `n` steps an edge) is within
@@ -519,8 +515,8 @@ impl<'a> Remesher<'a> {
     }
 
     /// Whether any of the proposed triangles `new` (corner ids and coordinates) meets another
-    /// triangle other than in the corners or the edge they share by index; triangles in `ignore` are about
-    /// to go and are not tested.
+    /// triangle other than in the corners or the edge they share by index; triangles in
+    /// `ignore` are about to go and are not tested.
     fn crosses(&self, new: &[([u32; 3], [P3; 3])], ignore: &[u32]) -> bool {
         let boxes: Vec<(P3, P3)> = new.iter().map(|(_, c)| bbox(c)).collect();
         for (i, (ci, c)) in new.iter().enumerate() {
