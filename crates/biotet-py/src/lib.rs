@@ -329,6 +329,7 @@ fn mesh_with(
     if let Some(r) = opts.recover.as_mut() {
         r.allow_interior_steiner = o.steiner;
     }
+    opts.seeds = o.steiner && improve_on;
     if !improve_on {
         opts.improve = None;
     }

@@ -22,6 +22,7 @@ pub mod polish;
 pub mod quality;
 pub mod recover2d;
 pub mod remesh;
+pub mod seeds;
 pub mod sizing;
 pub mod sizing_grid;
 pub mod smooth;

@@ -17,7 +17,7 @@ use crate::lastresort::{
 use crate::mesh::coord_key;
 use crate::mesh::inside::{RegionLocator, Transitions, centroid_region};
 use crate::mesh::surface::SurfaceMesh;
-use crate::mesh::tet::{NO_NEIGHBOR, TetMesh};
+use crate::mesh::tet::{NO_NEIGHBOR, TetMesh, retain_tets};
 use crate::polish::{PolishOptions, PolishReport, polish};
 use crate::sizing::Sizing;
 use crate::smooth::{SmoothError, SmoothOptions, SmoothReport, smooth};
@@ -38,6 +38,9 @@ pub struct PipelineOptions {
     /// Polish of the unforced tets still poor after smoothing (`None` skips it). Surface points
     /// stay. It runs only after recovery, which makes the boundary faces exact.
     pub polish: Option<PolishOptions>,
+    /// Interior seeds in sections too thin for the template's nodes ([`crate::seeds`]), after
+    /// recovery.
+    pub seeds: bool,
 }
 
 impl PipelineOptions {
@@ -48,6 +51,7 @@ impl PipelineOptions {
             improve: None,
             smooth: None,
             polish: None,
+            seeds: false,
             ..PipelineOptions::default()
         }
     }
@@ -78,6 +82,7 @@ impl Default for PipelineOptions {
                 ..SmoothOptions::default()
             }),
             polish: Some(PolishOptions::default()),
+            seeds: true,
         }
     }
 }
@@ -124,6 +129,8 @@ pub struct MeshReport {
     pub recover: Option<RecoverReport>,
     /// Retries of recovery without the interior nodes near the triangles it left, in order.
     pub retries: Vec<RetryReport>,
+    /// Interior seeds added in thin sections after recovery ([`crate::seeds`]).
+    pub seeds: usize,
     /// What sliver removal did (if it ran).
     pub improve: Option<ImproveReport>,
     /// What smoothing did (if it ran).
@@ -221,6 +228,12 @@ pub fn mesh_surface<S: Borrow<Sizing>>(
         }
     }
 
+    if opts.seeds && opts.recover.is_some() {
+        progress("seeding thin sections");
+        let clock = Instant::now();
+        report.seeds = crate::seeds::insert_seeds(&mut mesh, ns, surface);
+        stage(&mut report, "seeds", clock);
+    }
     if let Some(o) = &opts.improve {
         progress("removing slivers");
         let clock = Instant::now();
@@ -372,7 +385,8 @@ fn tetrahedralize(
     // by flood fill across the recovered surface (centroid tests only where it cannot: triangles
     // left unrecovered). Without it, the outside tets go here.
     if recover.is_none() {
-        keep_labelled(&mut tets, &mut neighbors, &mut labels);
+        let inside: Vec<bool> = labels.iter().map(|&l| l != 0).collect();
+        retain_tets(&mut tets, &mut neighbors, &mut labels, &inside);
     }
     let mut mesh = compact(points, tets, neighbors, labels);
     stage(report, "keep inside", clock);
@@ -515,41 +529,6 @@ fn clear_nodes(nodes: &mut Nodes, balls: &[([f64; 3], f64)]) -> usize {
 fn extent(points: &[[f64; 3]]) -> f64 {
     let (lo, hi) = crate::geom::vec3::points_bbox(points.iter());
     (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max)
-}
-
-/// Drop the tets labelled 0 (outside), in place, keeping the others' order; their neighbours
-/// there become [`NO_NEIGHBOR`].
-fn keep_labelled(tets: &mut Vec<[u32; 4]>, neighbors: &mut Vec<[u32; 4]>, labels: &mut Vec<u32>) {
-    let mut new_index = vec![NO_NEIGHBOR; tets.len()];
-    let mut k = 0u32;
-    for (slot, &l) in new_index.iter_mut().zip(labels.iter()) {
-        if l != 0 {
-            *slot = k;
-            k += 1;
-        }
-    }
-    // New index <= old index: moving down never overwrites a tet still to be moved.
-    for t in 0..tets.len() {
-        let new = new_index[t];
-        if new == NO_NEIGHBOR {
-            continue;
-        }
-        let nb = neighbors[t].map(|n| {
-            if n == NO_NEIGHBOR {
-                n
-            } else {
-                new_index[n as usize]
-            }
-        });
-        let new = new as usize;
-        tets[new] = tets[t];
-        neighbors[new] = nb;
-        labels[new] = labels[t];
-    }
-    let k = k as usize;
-    tets.truncate(k);
-    neighbors.truncate(k);
-    labels.truncate(k);
 }
 
 /// Assemble the mesh, dropping points no tet uses (the others keep their order, surface points

@@ -119,8 +119,14 @@ pub struct Args {
     /// unforced tets still below 10°).
     #[arg(long)]
     no_polish: bool,
+    /// Skip the interior seeds: points added after recovery at the circumcentres of poor tets
+    /// spanning a section too thin for the template's nodes (a square-section ring tube).
+    /// `--no-improve` skips them too.
+    #[arg(long)]
+    no_seeds: bool,
     /// Add no new points: recovery uses the seed's method alone (the run fails if a triangle
-    /// then cannot be recovered) and polishing adds no interior point. By default, where no fill
+    /// then cannot be recovered), no interior seeds are added and polishing adds no interior
+    /// point. By default, where no fill
     /// exists without new points, recovery adds Steiner points strictly inside the domain (never
     /// on the surface).
     #[arg(long)]
@@ -312,6 +318,8 @@ pub fn run(a: Args) -> Result<ExitCode> {
     if a.no_improve {
         opts.improve = None;
     }
+    // Seeds are a quality step, as polishing is: a raw mesh (--no-improve) has none.
+    opts.seeds = !(a.no_seeds || a.no_steiner || a.no_improve);
     if a.no_steiner
         && let Some(p) = opts.polish.as_mut()
     {
@@ -495,6 +503,12 @@ pub fn run(a: Args) -> Result<ExitCode> {
             text += &format!(
                 "recover: {} Steiner points added strictly inside (never on the surface)\n",
                 r.steiner_points
+            );
+        }
+        if report.seeds > 0 {
+            text += &format!(
+                "seeds: {} interior points where a section was too thin for the template's nodes\n",
+                report.seeds
             );
         }
         if !report.retries.is_empty() {

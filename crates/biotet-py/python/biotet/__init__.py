@@ -493,8 +493,8 @@ def mesh(
     ``size_field_array`` naming a .vti array, or a :class:`SizeField`; as ``--size-field``), else
     from the surface's own edges growing by ``grading`` per unit distance; all clamped to
     ``min_size``/``max_size``. ``region_sizes`` maps a region label to a uniform size inside it
-    (``--region-size``). ``steiner=False`` forbids interior points added by recovery
-    (``--no-steiner``); ``recover``/``improve``/``smooth``/``polish`` switch stages off.
+    (``--region-size``). ``steiner=False`` forbids new interior points (recovery's,
+    the seeds in thin sections, polishing's; ``--no-steiner``); ``recover``/``improve``/``smooth``/``polish`` switch stages off.
     ``surface_tolerance=D`` first remeshes the surface within a two-sided Hausdorff distance D
     (``--surface-tolerance D``; reported in ``report["surface"]``): fewer slivers, the surface
     no longer kept exactly; ``surface_feature_angle``, ``surface_rounds`` and ``adaptive_size``
@@ -575,8 +575,8 @@ def mesh_image(
     ``size_field_array`` naming a .vti array, or a :class:`SizeField`; as ``--size-field``), else
     from the surface's own edges growing by ``grading`` per unit distance; all clamped to
     ``min_size``/``max_size``. ``region_sizes`` maps a region label to a uniform size inside it
-    (``--region-size``). ``steiner=False`` forbids interior points added by recovery
-    (``--no-steiner``); ``recover``/``improve``/``smooth``/``polish`` switch stages off.
+    (``--region-size``). ``steiner=False`` forbids new interior points (recovery's,
+    the seeds in thin sections, polishing's; ``--no-steiner``); ``recover``/``improve``/``smooth``/``polish`` switch stages off.
     ``surface_tolerance=D`` first remeshes the surface within a two-sided Hausdorff distance D
     (``--surface-tolerance D``; reported in ``report["surface"]``): fewer slivers, the surface
     no longer kept exactly; ``surface_feature_angle``, ``surface_rounds`` and ``adaptive_size``
@@ -648,8 +648,8 @@ def mesh_file(
     ``size_field_array`` naming a .vti array, or a :class:`SizeField`; as ``--size-field``), else
     from the surface's own edges growing by ``grading`` per unit distance; all clamped to
     ``min_size``/``max_size``. ``region_sizes`` maps a region label to a uniform size inside it
-    (``--region-size``). ``steiner=False`` forbids interior points added by recovery
-    (``--no-steiner``); ``recover``/``improve``/``smooth``/``polish`` switch stages off.
+    (``--region-size``). ``steiner=False`` forbids new interior points (recovery's,
+    the seeds in thin sections, polishing's; ``--no-steiner``); ``recover``/``improve``/``smooth``/``polish`` switch stages off.
     ``surface_tolerance=D`` first remeshes the surface within a two-sided Hausdorff distance D
     (``--surface-tolerance D``; reported in ``report["surface"]``): fewer slivers, the surface
     no longer kept exactly; ``surface_feature_angle``, ``surface_rounds`` and ``adaptive_size``

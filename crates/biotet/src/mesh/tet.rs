@@ -166,6 +166,46 @@ pub(crate) fn sorted3(mut f: [u32; 3]) -> [u32; 3] {
     f
 }
 
+/// Keep the tets `t` with `keep[t]`, in place, in their order; a neighbour dropped becomes
+/// [`NO_NEIGHBOR`], the others are renumbered.
+pub fn retain_tets(
+    tets: &mut Vec<[u32; 4]>,
+    neighbors: &mut Vec<[u32; 4]>,
+    labels: &mut Vec<u32>,
+    keep: &[bool],
+) {
+    let mut new_index = vec![NO_NEIGHBOR; tets.len()];
+    let mut k = 0u32;
+    for (slot, &kept) in new_index.iter_mut().zip(keep) {
+        if kept {
+            *slot = k;
+            k += 1;
+        }
+    }
+    // New index <= old index: moving down never overwrites a tet still to be moved.
+    for t in 0..tets.len() {
+        let new = new_index[t];
+        if new == NO_NEIGHBOR {
+            continue;
+        }
+        let nb = neighbors[t].map(|n| {
+            if n == NO_NEIGHBOR {
+                n
+            } else {
+                new_index[n as usize]
+            }
+        });
+        let new = new as usize;
+        tets[new] = tets[t];
+        neighbors[new] = nb;
+        labels[new] = labels[t];
+    }
+    let k = k as usize;
+    tets.truncate(k);
+    neighbors.truncate(k);
+    labels.truncate(k);
+}
+
 /// Face adjacency of a tet array: `(neighbors, faces in more than two tets)`. Each face is
 /// matched among the tets around its corner of fewest tets (a vertex-to-tet incidence built by
 /// a counting sort): linear, no hashing, no sort, and 16 bytes per tet of scratch (the mesh

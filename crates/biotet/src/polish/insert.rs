@@ -33,7 +33,7 @@ use crate::geom::predicates::{Sign, in_exact_range, orient3d};
 use crate::geom::vec3::{add, cross, dot, norm2, scale, sub, volume6};
 use crate::lastresort::Searcher;
 use crate::mesh::tet::{NO_NEIGHBOR, TET_EDGES};
-use crate::quality::tet::{dihedral_angles, min_dihedral_chord2};
+use crate::quality::tet::{circumcentre, dihedral_angles, min_dihedral_chord2};
 
 use super::refill::{
     Judge, RefillParams, every_face_has_candidate, faces_flat_in_hull, faces_without_candidate,
@@ -592,21 +592,4 @@ fn kernel_point(planes: &[(P3, P3)], mut x: P3, margin: f64) -> Option<P3> {
 
 fn centroid(c: &[P3; 4]) -> P3 {
     scale(add(add(c[0], c[1]), add(c[2], c[3])), 0.25)
-}
-
-/// The circumcentre of a tet (None when flat in floating point).
-fn circumcentre(c: &[P3; 4]) -> Option<P3> {
-    let a = sub(c[1], c[0]);
-    let b = sub(c[2], c[0]);
-    let d = sub(c[3], c[0]);
-    let den = 2.0 * dot(a, cross(b, d));
-    if den == 0.0 || !den.is_finite() {
-        return None;
-    }
-    let num = add(
-        add(scale(cross(b, d), norm2(a)), scale(cross(d, a), norm2(b))),
-        scale(cross(a, b), norm2(d)),
-    );
-    let o = add(c[0], scale(num, 1.0 / den));
-    o.iter().all(|k| k.is_finite()).then_some(o)
 }

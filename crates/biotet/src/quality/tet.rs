@@ -3,6 +3,23 @@
 use crate::geom::vec3::{add, cross, dot, norm, norm2, scale, sub, volume6};
 use crate::mesh::tet::TET_EDGES;
 
+/// The circumcentre of a tet (None when flat in floating point).
+pub fn circumcentre(c: &[[f64; 3]; 4]) -> Option<[f64; 3]> {
+    let a = sub(c[1], c[0]);
+    let b = sub(c[2], c[0]);
+    let d = sub(c[3], c[0]);
+    let den = 2.0 * dot(a, cross(b, d));
+    if den == 0.0 || !den.is_finite() {
+        return None;
+    }
+    let num = add(
+        add(scale(cross(b, d), norm2(a)), scale(cross(d, a), norm2(b))),
+        scale(cross(a, b), norm2(d)),
+    );
+    let o = add(c[0], scale(num, 1.0 / den));
+    o.iter().all(|k| k.is_finite()).then_some(o)
+}
+
 /// Solid angle at each vertex of a regular tetrahedron, `3·acos(1/3) − π` steradians (eq. 4.2).
 pub const REGULAR_SOLID_ANGLE: f64 = 0.551_285_598_432_530_8;
 

@@ -11,6 +11,7 @@ mod polish;
 mod predicates;
 mod quality;
 mod remesh;
+mod seeds;
 mod shells;
 mod side_labels;
 mod sizing;

@@ -326,8 +326,12 @@ fn polish_rescues_the_flattest_tet_of_a_cad_stl() {
     validate_surface(&mut s, &ValidateOptions::default()).unwrap();
     let sizing = crate::common::default_sizing(&s);
     // Recovery without the small first cavities, which leaves the flat tet this test is about
-    // (with them it leaves none for polish to rescue).
-    let mut opts = PipelineOptions::default();
+    // (with them it leaves none for polish to rescue), and without the seeds (whose points
+    // change the tets there).
+    let mut opts = PipelineOptions {
+        seeds: false,
+        ..PipelineOptions::default()
+    };
     if let Some(r) = opts.recover.as_mut() {
         r.first_cavity_tets = r.max_cavity_tets;
     }
@@ -359,8 +363,11 @@ fn polish_at_least_halves_the_tets_under_10_degrees_of_a_square_section_ring_tub
     let sizing = crate::common::default_sizing(&s);
     let bad = |m: &TetMesh| (0..m.tets.len()).filter(|&t| min_deg(m, t) < 10.0).count();
     let defaults = PipelineOptions::default();
+    // Without the seeds, which put TetGen's points in the segments before polish runs
+    // (tests/all/seeds.rs).
     let no_polish = PipelineOptions {
         polish: None,
+        seeds: false,
         ..defaults.clone()
     };
     let (mut m, _) = mesh_surface(&s, &sizing, &no_polish, &mut |_| {}).unwrap();

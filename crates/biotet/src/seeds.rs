@@ -1,0 +1,282 @@
+//! Interior seeds where node deployment placed none: the circumcentres of the poor tets that
+//! join surface points across a thin section, each inserted by coning its cavity.
+//!
+//! The template keeps its nodes a sealing distance from the surface, so a section thinner than
+//! that (a square-section ring tube, a thin bar) gets no interior node, and every tet there
+//! joins surface points from wall to wall. Where such a tet is poor, the circumcentre of it or
+//! of a neighbour of the same kind (a flat tet on a planar quad has none of its own) is the point
+//! Delaunay refinement would add (TetGen's `q` puts one in each segment of a square-section ring
+//! tube). It becomes a seed when it lies strictly inside the region, clear of the surface and of
+//! the points around it, and the tets whose circumspheres hold it, reached through faces of the
+//! region, form a cavity whose every shell face sees it strictly inside (exact `orient3d`), with
+//! no point lost, and whose cone's worst dihedral angle is above [`SEED_BELOW_DEG`] and above the
+//! cavity's worst. Cavities of two seeds never share a tet; every accepted cone replaces its
+//! cavity at once. Boundary and interface faces are never crossed, so they stay faces.
+//!
+//! The choice of points is floating point, as node placement is; every tet made is checked
+//! positive exactly. Sequential, in tet order: the same mesh on any number of threads.
+
+use rayon::prelude::*;
+
+use crate::geom::predicates::{Sign, orient3d};
+use crate::geom::vec3::{norm2, sub};
+use crate::mesh::cavity;
+use crate::mesh::surface::SurfaceMesh;
+use crate::mesh::tet::{NO_NEIGHBOR, TetMesh, retain_tets};
+use crate::quality::tet::{circumcentre, min_dihedral_deg_by_chord};
+use crate::surface::bvh::Bvh;
+
+type P3 = [f64; 3];
+
+/// Tets of surface points below this smallest dihedral angle (degrees) give candidates, and a
+/// seed's cone must be above it.
+pub const SEED_BELOW_DEG: f64 = 10.0;
+
+/// A seed's clearance from the surface and from the points around it, as a fraction of its
+/// tet's circumradius (the centre of a square section is 0.38 of it from the walls).
+const SEED_CLEARANCE: f64 = 0.3;
+
+/// Steps of the walk that locates a circumcentre.
+const WALK_STEPS: usize = 64;
+
+/// Largest cavity a seed may take, in tets.
+const MAX_CAVITY: usize = 64;
+
+/// Insert the seeds into `mesh`, whose first `ns` points are the surface's (`surface` its
+/// boundary); returns how many. Adjacency is kept.
+pub fn insert_seeds(mesh: &mut TetMesh, ns: usize, surface: &SurfaceMesh) -> usize {
+    let seeds = choose(mesh, ns, surface);
+    let n = seeds.len();
+    // A cone may have fewer tets than its cavity: the slots left over go at the end.
+    let mut dead: Vec<u32> = Vec::new();
+    for seed in seeds {
+        cone_in(mesh, seed, &mut dead);
+    }
+    if !dead.is_empty() {
+        let mut keep = vec![true; mesh.tets.len()];
+        for t in dead {
+            keep[t as usize] = false;
+        }
+        let TetMesh {
+            tets,
+            neighbors,
+            labels,
+            ..
+        } = mesh;
+        retain_tets(tets, neighbors, labels, &keep);
+    }
+    n
+}
+
+/// Replace a seed's cavity by its cone, adjacency kept ([`crate::mesh::cavity`]): the cone's
+/// tets take the cavity's slots in order, then new ones; slots left over are added to `dead`.
+fn cone_in(mesh: &mut TetMesh, (x, cavity): Seed, dead: &mut Vec<u32>) {
+    let p = mesh.points.len() as u32;
+    mesh.points.push(x);
+    let label = mesh.labels[cavity[0] as usize];
+    let inside = |t: u32| cavity.binary_search(&t).is_ok();
+    let (faces, outer) = cavity::shell(&cavity, &mesh.tets, &mesh.neighbors, inside);
+    let mut ids = Vec::with_capacity(faces.len());
+    for (j, f) in faces.iter().enumerate() {
+        // The shell's faces point into the cavity, at x.
+        let tet = [f[0], f[1], f[2], p];
+        match cavity.get(j) {
+            Some(&s) => {
+                mesh.tets[s as usize] = tet;
+                ids.push(s);
+            }
+            None => {
+                ids.push(mesh.tets.len() as u32);
+                mesh.tets.push(tet);
+                mesh.labels.push(label);
+                mesh.neighbors.push([NO_NEIGHBOR; 4]);
+            }
+        }
+    }
+    dead.extend(cavity.iter().skip(faces.len()));
+    cavity::stitch(&mesh.tets, &mut mesh.neighbors, &ids, &faces, &outer);
+}
+
+/// A seed: its point and its cavity's tets (sorted).
+type Seed = (P3, Vec<u32>);
+
+/// The seeds of the module docs, in the order of the tets that gave them: each poor tet not in
+/// an earlier seed's cavity tries its candidates in turn, the first that passes its seed.
+fn choose(mesh: &TetMesh, ns: usize, surface: &SurfaceMesh) -> Vec<Seed> {
+    let on_surface = |t: u32| mesh.tets[t as usize].iter().all(|&x| (x as usize) < ns);
+    let corners = |t: u32| mesh.tets[t as usize].map(|x| mesh.points[x as usize]);
+    let bad: Vec<u32> = (0..mesh.tets.len() as u32)
+        .into_par_iter()
+        .filter(|&t| on_surface(t) && min_dihedral_deg_by_chord(&corners(t)) < SEED_BELOW_DEG)
+        .collect();
+    if bad.is_empty() {
+        return Vec::new();
+    }
+    let tris: Vec<[P3; 3]> = surface
+        .triangles
+        .iter()
+        .map(|t| t.map(|v| surface.points[v as usize]))
+        .collect();
+    let ids = (0..tris.len() as u32).collect();
+    let bvh = Bvh::new(tris, ids);
+    let mut claimed = vec![false; mesh.tets.len()];
+    let mut seeds: Vec<Seed> = Vec::new();
+    for t in bad {
+        if claimed[t as usize] {
+            continue;
+        }
+        // Its own circumcentre, then its surface-only neighbours' (a flat tet on a planar quad
+        // has none of its own).
+        let tries = std::iter::once(t).chain(
+            mesh.neighbors[t as usize]
+                .into_iter()
+                .filter(|&n| n != NO_NEIGHBOR && on_surface(n)),
+        );
+        if let Some(seed) = tries
+            .into_iter()
+            .find_map(|u| candidate(mesh, &bvh, u, &claimed))
+        {
+            for &x in &seed.1 {
+                claimed[x as usize] = true;
+            }
+            seeds.push(seed);
+        }
+    }
+    seeds
+}
+
+/// The seed at the circumcentre of tet `u`, if it passes every test of the module docs with
+/// the tets `claimed` by earlier seeds left alone.
+fn candidate(mesh: &TetMesh, bvh: &Bvh, u: u32, claimed: &[bool]) -> Option<Seed> {
+    let c = mesh.tets[u as usize].map(|x| mesh.points[x as usize]);
+    let o = circumcentre(&c)?;
+    let clear2 = SEED_CLEARANCE * SEED_CLEARANCE * norm2(sub(c[0], o));
+    let s = locate(mesh, u, o)?;
+    let near_point = std::iter::once(s)
+        .chain(mesh.neighbors[s as usize])
+        .filter(|&n| n != NO_NEIGHBOR)
+        .flat_map(|n| mesh.tets[n as usize])
+        .any(|x| norm2(sub(mesh.points[x as usize], o)) < clear2);
+    if near_point || bvh.any_within(o, clear2) {
+        return None;
+    }
+    Some((o, cone(mesh, s, o, claimed)?))
+}
+
+/// The cavity of `x` from `s` (the tets of `s`'s region whose circumspheres hold `x`, reached
+/// through faces; at most [`MAX_CAVITY`]), sorted, when coning its shell to `x` is valid
+/// (every cone tet strictly positive, exact; every cavity point on the shell) and better (the
+/// cone's worst dihedral angle above [`SEED_BELOW_DEG`] and above the cavity's worst), and no
+/// tet of it `claimed` by an earlier seed.
+fn cone(mesh: &TetMesh, s: u32, x: P3, claimed: &[bool]) -> Option<Vec<u32>> {
+    if claimed[s as usize] {
+        return None;
+    }
+    let label = mesh.labels[s as usize];
+    let corners = |t: u32| mesh.tets[t as usize].map(|v| mesh.points[v as usize]);
+    let mut cavity = vec![s];
+    let mut i = 0;
+    while i < cavity.len() {
+        let t = cavity[i];
+        i += 1;
+        for n in mesh.neighbors[t as usize] {
+            if n == NO_NEIGHBOR || mesh.labels[n as usize] != label || cavity.contains(&n) {
+                continue;
+            }
+            let c = corners(n);
+            if circumcentre(&c).is_some_and(|o| norm2(sub(x, o)) < norm2(sub(c[0], o))) {
+                // Another seed's cavity: two cones never share a tet.
+                if claimed[n as usize] {
+                    return None;
+                }
+                cavity.push(n);
+                if cavity.len() > MAX_CAVITY {
+                    return None;
+                }
+            }
+        }
+    }
+    cavity.sort_unstable();
+    // The cone's tets first, the first one below the floor ending the test (most candidates
+    // end so), then the cavity's.
+    let mut new = 180.0f64;
+    let mut shell = Vec::new();
+    let mut on_shell = Vec::new();
+    for &t in &cavity {
+        let c = corners(t);
+        for k in 0..4 {
+            let n = mesh.neighbors[t as usize][k];
+            if n != NO_NEIGHBOR && cavity.binary_search(&n).is_ok() {
+                continue;
+            }
+            let mut w = c;
+            w[k] = x;
+            if orient3d(w[0], w[1], w[2], w[3]) != Sign::Positive {
+                return None;
+            }
+            new = new.min(min_dihedral_deg_by_chord(&w));
+            if new < SEED_BELOW_DEG {
+                return None;
+            }
+            shell.push((t, k));
+            let v = mesh.tets[t as usize];
+            on_shell.extend((0..4).filter(|&j| j != k).map(|j| v[j]));
+        }
+    }
+    // Every shell face seen strictly from inside makes the cone a triangulation of the cavity
+    // only if the shell is a sphere (a shell wrapped twice around x passes that test too): every
+    // edge on two faces, and V - E + F = 2 (the shell is embedded and closed, so connected).
+    let mut edges: Vec<[u32; 2]> = Vec::with_capacity(3 * shell.len());
+    for &(t, k) in &shell {
+        let v = mesh.tets[t as usize];
+        let f: Vec<u32> = (0..4).filter(|&j| j != k).map(|j| v[j]).collect();
+        for (a, b) in [(f[0], f[1]), (f[1], f[2]), (f[0], f[2])] {
+            edges.push([a.min(b), a.max(b)]);
+        }
+    }
+    edges.sort_unstable();
+    let manifold = edges.chunks(2).all(|e| e.len() == 2 && e[0] == e[1])
+        && edges.windows(3).all(|w| !(w[0] == w[1] && w[1] == w[2]));
+    on_shell.sort_unstable();
+    on_shell.dedup();
+    let sphere = manifold && on_shell.len() + shell.len() == edges.len() / 2 + 2;
+    let lost = cavity
+        .iter()
+        .flat_map(|&t| mesh.tets[t as usize])
+        .any(|v| on_shell.binary_search(&v).is_err());
+    let old = cavity
+        .iter()
+        .map(|&t| min_dihedral_deg_by_chord(&corners(t)))
+        .fold(180.0, f64::min);
+    (sphere && !lost && new > old).then_some(cavity)
+}
+
+/// The tet of `t`'s region holding `x` strictly inside, walking from `t` through faces `x` lies
+/// strictly beyond (exact); `None` if the walk would leave the region, lands on a face or stalls.
+fn locate(mesh: &TetMesh, t: u32, x: P3) -> Option<u32> {
+    let label = mesh.labels[t as usize];
+    let mut s = t;
+    'walk: for _ in 0..WALK_STEPS {
+        let v = mesh.tets[s as usize].map(|i| mesh.points[i as usize]);
+        let mut on_face = false;
+        for k in 0..4 {
+            // x in place of corner k: negative when x lies beyond the face opposite it.
+            let mut w = v;
+            w[k] = x;
+            match orient3d(w[0], w[1], w[2], w[3]) {
+                Sign::Negative => {
+                    let n = mesh.neighbors[s as usize][k];
+                    if n == NO_NEIGHBOR || mesh.labels[n as usize] != label {
+                        return None;
+                    }
+                    s = n;
+                    continue 'walk;
+                }
+                Sign::Zero => on_face = true,
+                Sign::Positive => {}
+            }
+        }
+        return (!on_face).then_some(s);
+    }
+    None
+}
