@@ -767,6 +767,10 @@ SHAPES = {
     "tm_square_torus": (tm("torus", major_radius=1.0, minor_radius=0.01, major_sections=200, minor_sections=4),
                         "trimesh {trimesh} creation.torus(1, 0.01, 200, 4)", "generated",
                         "square-section ring tube: planar isosceles-trapezoid faces (cocircular quads), 200 short segments"),
+    "tm_tri_torus": (tm("torus", major_radius=1.0, minor_radius=0.01, major_sections=200, minor_sections=3),
+                     "trimesh {trimesh} creation.torus(1, 0.01, 200, 3)", "generated",
+                     "triangular-section ring tube: each segment a twisted prism, its centre a quarter of its "
+                     "circumradius from the walls"),
     "tm_thin_annulus": (tm("annulus", r_min=1.0, r_max=1.01, height=1.0, sections=64),
                         "trimesh {trimesh} creation.annulus(r_min=1, r_max=1.01, height=1, sections=64)", "generated",
                         "ring wall a hundredth of its radius: every tet spans the wall"),

@@ -33,8 +33,10 @@ type P3 = [f64; 3];
 pub const SEED_BELOW_DEG: f64 = 10.0;
 
 /// A seed's clearance from the surface and from the points around it, as a fraction of its
-/// tet's circumradius (the centre of a square section is 0.38 of it from the walls).
-const SEED_CLEARANCE: f64 = 0.3;
+/// tet's circumradius: the centre of a segment of a ring tube is 0.38 of it from the walls for a
+/// square section, 0.27 for a triangular one (whose cones stay above 10°); the cone's own test
+/// is what keeps the seeds that would make slivers out.
+const SEED_CLEARANCE: f64 = 0.2;
 
 /// Steps of the walk that locates a circumcentre.
 const WALK_STEPS: usize = 64;
