@@ -171,77 +171,44 @@ fn candidate(mesh: &TetMesh, bvh: &Bvh, u: u32, claimed: &[bool]) -> Option<Seed
 /// cone's worst dihedral angle above [`SEED_BELOW_DEG`] and above the cavity's worst), and no
 /// tet of it `claimed` by an earlier seed.
 fn cone(mesh: &TetMesh, s: u32, x: P3, claimed: &[bool]) -> Option<Vec<u32>> {
-    if claimed[s as usize] {
-        return None;
-    }
     let label = mesh.labels[s as usize];
     let corners = |t: u32| mesh.tets[t as usize].map(|v| mesh.points[v as usize]);
-    let mut cavity = vec![s];
-    let mut i = 0;
-    while i < cavity.len() {
-        let t = cavity[i];
-        i += 1;
-        for n in mesh.neighbors[t as usize] {
-            if n == NO_NEIGHBOR || mesh.labels[n as usize] != label || cavity.contains(&n) {
-                continue;
-            }
-            let c = corners(n);
-            if circumcentre(&c).is_some_and(|o| norm2(sub(x, o)) < norm2(sub(c[0], o))) {
-                // Another seed's cavity: two cones never share a tet.
-                if claimed[n as usize] {
-                    return None;
-                }
-                cavity.push(n);
-                if cavity.len() > MAX_CAVITY {
-                    return None;
-                }
-            }
-        }
+    let same = |n: u32| mesh.labels[n as usize] == label;
+    let cavity = cavity::circumsphere_cavity(s, x, MAX_CAVITY, &mesh.neighbors, corners, same)?;
+    // Another seed's cavity: two cones never share a tet.
+    if cavity.iter().any(|&t| claimed[t as usize]) {
+        return None;
     }
-    cavity.sort_unstable();
+    let inside = |t: u32| cavity.binary_search(&t).is_ok();
+    let (faces, _) = cavity::shell(&cavity, &mesh.tets, &mesh.neighbors, inside);
     // The cone's tets first, the first one below the floor ending the test (most candidates
     // end so), then the cavity's.
     let mut new = 180.0f64;
-    let mut shell = Vec::new();
-    let mut on_shell = Vec::new();
-    for &t in &cavity {
-        let c = corners(t);
-        for k in 0..4 {
-            let n = mesh.neighbors[t as usize][k];
-            if n != NO_NEIGHBOR && cavity.binary_search(&n).is_ok() {
-                continue;
-            }
-            let mut w = c;
-            w[k] = x;
-            if orient3d(w[0], w[1], w[2], w[3]) != Sign::Positive {
-                return None;
-            }
-            new = new.min(min_dihedral_deg_by_chord(&w));
-            if new < SEED_BELOW_DEG {
-                return None;
-            }
-            shell.push((t, k));
-            let v = mesh.tets[t as usize];
-            on_shell.extend((0..4).filter(|&j| j != k).map(|j| v[j]));
+    for f in &faces {
+        let w = [f[0], f[1], f[2]].map(|v| mesh.points[v as usize]);
+        if orient3d(w[0], w[1], w[2], x) != Sign::Positive {
+            return None;
+        }
+        new = new.min(min_dihedral_deg_by_chord(&[w[0], w[1], w[2], x]));
+        if new < SEED_BELOW_DEG {
+            return None;
         }
     }
     // Every shell face seen strictly from inside makes the cone a triangulation of the cavity
     // only if the shell is a sphere (a shell wrapped twice around x passes that test too): every
     // edge on two faces, and V - E + F = 2 (the shell is embedded and closed, so connected).
-    let mut edges: Vec<[u32; 2]> = Vec::with_capacity(3 * shell.len());
-    for &(t, k) in &shell {
-        let v = mesh.tets[t as usize];
-        let f: Vec<u32> = (0..4).filter(|&j| j != k).map(|j| v[j]).collect();
-        for (a, b) in [(f[0], f[1]), (f[1], f[2]), (f[0], f[2])] {
-            edges.push([a.min(b), a.max(b)]);
-        }
-    }
+    let mut edges: Vec<[u32; 2]> = faces
+        .iter()
+        .flat_map(|f| [(f[0], f[1]), (f[1], f[2]), (f[0], f[2])])
+        .map(|(a, b)| [a.min(b), a.max(b)])
+        .collect();
     edges.sort_unstable();
     let manifold = edges.chunks(2).all(|e| e.len() == 2 && e[0] == e[1])
         && edges.windows(3).all(|w| !(w[0] == w[1] && w[1] == w[2]));
+    let mut on_shell: Vec<u32> = faces.iter().flatten().copied().collect();
     on_shell.sort_unstable();
     on_shell.dedup();
-    let sphere = manifold && on_shell.len() + shell.len() == edges.len() / 2 + 2;
+    let sphere = manifold && on_shell.len() + faces.len() == edges.len() / 2 + 2;
     let lost = cavity
         .iter()
         .flat_map(|&t| mesh.tets[t as usize])

@@ -2,7 +2,10 @@
 //! the tets that replace it. Shared by sliver removal and polishing, which keep tombstoned slots
 //! of their own.
 
-use rustc_hash::FxHashMap;
+use rustc_hash::{FxHashMap, FxHashSet};
+
+use crate::geom::vec3::{norm2, sub};
+use crate::quality::tet::circumcentre;
 
 use super::tet::{NO_NEIGHBOR, TET_FACES};
 
@@ -74,6 +77,43 @@ pub fn stitch(
         }
     }
     debug_assert!(open.is_empty(), "the new tets do not fill the cavity");
+}
+
+/// `start` and the tets whose circumspheres strictly hold `x` and that `admit` (asked only of
+/// those), reached from it through faces (never across [`NO_NEIGHBOR`]), sorted: Delaunay
+/// refinement's cavity for a point at `x`. `None` past `max` tets. Floating point: it chooses a cavity, whose use the
+/// caller decides exactly.
+pub fn circumsphere_cavity(
+    start: u32,
+    x: [f64; 3],
+    max: usize,
+    nb: &[[u32; 4]],
+    corners: impl Fn(u32) -> [[f64; 3]; 4],
+    admit: impl Fn(u32) -> bool,
+) -> Option<Vec<u32>> {
+    let mut out = vec![start];
+    let mut seen: FxHashSet<u32> = FxHashSet::default();
+    seen.insert(start);
+    let mut i = 0;
+    while i < out.len() {
+        let s = out[i];
+        i += 1;
+        for n in nb[s as usize] {
+            if n == NO_NEIGHBOR || !seen.insert(n) {
+                continue;
+            }
+            let c = corners(n);
+            if circumcentre(&c).is_some_and(|o| norm2(sub(x, o)) < norm2(sub(c[0], o))) && admit(n)
+            {
+                out.push(n);
+                if out.len() > max {
+                    return None;
+                }
+            }
+        }
+    }
+    out.sort_unstable();
+    Some(out)
 }
 
 #[cfg(test)]

@@ -154,32 +154,17 @@ impl Work {
     /// `t` through faces (so never across a boundary or interface face), sorted; at most `max`
     /// (else `None`). Floating point: it only chooses the cavity, whose use is decided
     /// exactly by [`Self::insert_into`].
-    fn circumsphere_cavity(&mut self, t: u32, x: P3, max: usize) -> Option<Vec<u32>> {
+    fn circumsphere_cavity(&self, t: u32, x: P3, max: usize) -> Option<Vec<u32>> {
         let label = self.labels[t as usize];
-        let mut out = vec![t];
-        let mut seen: FxHashSet<u32> = FxHashSet::default();
-        seen.insert(t);
-        let mut i = 0;
-        while i < out.len() {
-            let s = out[i];
-            i += 1;
-            for n in self.nb[s as usize] {
-                if self.outside(label, n) || !seen.insert(n) {
-                    continue;
-                }
-                let c = self.corners(n);
-                let inside =
-                    circumcentre(&c).is_some_and(|o| norm2(sub(x, o)) < norm2(sub(c[0], o)));
-                if inside && !self.is_forced(n) {
-                    out.push(n);
-                    if out.len() > max {
-                        return None;
-                    }
-                }
-            }
-        }
-        out.sort_unstable();
-        Some(out)
+        let this = self;
+        crate::mesh::cavity::circumsphere_cavity(
+            t,
+            x,
+            max,
+            &this.nb,
+            |n| this.corners(n),
+            |n| !this.outside(label, n) && !this.forced_now(n),
+        )
     }
 
     /// A wedge: `t`'s one small angle, at edge `cd`, comes from the short opposite edge `ab`

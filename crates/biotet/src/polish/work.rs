@@ -218,6 +218,15 @@ impl Work {
         }
     }
 
+    /// [`Self::is_forced`] without filling its cache.
+    pub fn forced_now(&self, t: u32) -> bool {
+        match self.forced[t as usize] {
+            1 => true,
+            2 => false,
+            _ => self.compute_forced(t),
+        }
+    }
+
     fn compute_forced(&self, t: u32) -> bool {
         let tv = self.tets[t as usize];
         if tv.iter().filter(|&&v| self.fixed[v as usize]).count() < 2 {
