@@ -507,7 +507,8 @@ pub fn run(a: Args) -> Result<ExitCode> {
         }
         if report.seeds > 0 {
             text += &format!(
-                "seeds: {} interior points where a section was too thin for the template's nodes\n",
+                "seeds: {} interior points at the circumcentres of poor tets of surface points \
+                 (thin sections)\n",
                 report.seeds
             );
         }
