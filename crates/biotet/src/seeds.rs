@@ -8,7 +8,9 @@
 //! Delaunay refinement would add (TetGen's `q` puts one in each segment of a square-section ring
 //! tube). It becomes a seed when it lies strictly inside the region, clear of the surface and of
 //! the points around it, and the tets whose circumspheres hold it, reached through faces of the
-//! region, form a cavity whose every shell face sees it strictly inside (exact `orient3d`), with
+//! region (with the poor tets beside them when that passes, else alone: a flat tet on a planar
+//! quad has no circumsphere to hold it), form a cavity whose every shell face sees it strictly
+//! inside (exact `orient3d`), with
 //! no point lost, and whose cone's worst dihedral angle is above [`SEED_BELOW_DEG`] and above the
 //! cavity's worst. Cavities of two seeds never share a tet; every accepted cone replaces its
 //! cavity at once. Boundary and interface faces are never crossed, so they stay faces.
@@ -166,10 +168,8 @@ fn candidate(mesh: &TetMesh, bvh: &Bvh, u: u32, claimed: &[bool]) -> Option<Seed
 }
 
 /// The cavity of `x` from `s` (the tets of `s`'s region whose circumspheres hold `x`, reached
-/// through faces; at most [`MAX_CAVITY`]), sorted, when coning its shell to `x` is valid
-/// (every cone tet strictly positive, exact; every cavity point on the shell) and better (the
-/// cone's worst dihedral angle above [`SEED_BELOW_DEG`] and above the cavity's worst), and no
-/// tet of it `claimed` by an earlier seed.
+/// through faces; at most [`MAX_CAVITY`]), with the poor tets beside it or else alone, sorted,
+/// when [`cone_ok`] passes it and no tet of it is `claimed` by an earlier seed.
 fn cone(mesh: &TetMesh, s: u32, x: P3, claimed: &[bool]) -> Option<Vec<u32>> {
     let label = mesh.labels[s as usize];
     let corners = |t: u32| mesh.tets[t as usize].map(|v| mesh.points[v as usize]);
@@ -179,6 +179,44 @@ fn cone(mesh: &TetMesh, s: u32, x: P3, claimed: &[bool]) -> Option<Vec<u32>> {
     if cavity.iter().any(|&t| claimed[t as usize]) {
         return None;
     }
+    // The poor tets beside it first: a flat tet on a planar quad of the wall has no
+    // circumsphere to hold x, and a cone that leaves it is no better than the good tets it
+    // replaces (the triangular ring tube's segments).
+    let grown = with_poor_neighbours(mesh, &cavity, |n| same(n) && !claimed[n as usize]);
+    if grown.len() > cavity.len() && grown.len() <= MAX_CAVITY && cone_ok(mesh, &grown, x) {
+        return Some(grown);
+    }
+    cone_ok(mesh, &cavity, x).then_some(cavity)
+}
+
+/// `cavity` and, repeatedly, the tets beside it that `admit` lets in and whose smallest
+/// dihedral angle is below [`SEED_BELOW_DEG`]; sorted.
+fn with_poor_neighbours(mesh: &TetMesh, cavity: &[u32], admit: impl Fn(u32) -> bool) -> Vec<u32> {
+    let corners = |t: u32| mesh.tets[t as usize].map(|v| mesh.points[v as usize]);
+    let mut out = cavity.to_vec();
+    let mut i = 0;
+    while i < out.len() && out.len() <= MAX_CAVITY {
+        let t = out[i];
+        i += 1;
+        for n in mesh.neighbors[t as usize] {
+            if n != NO_NEIGHBOR
+                && !out.contains(&n)
+                && admit(n)
+                && min_dihedral_deg_by_chord(&corners(n)) < SEED_BELOW_DEG
+            {
+                out.push(n);
+            }
+        }
+    }
+    out.sort_unstable();
+    out
+}
+
+/// Whether coning `cavity`'s shell to `x` is valid (every cone tet strictly positive, exact;
+/// the shell a sphere; every cavity point on it) and better (the cone's worst dihedral angle
+/// above [`SEED_BELOW_DEG`] and above the cavity's worst).
+fn cone_ok(mesh: &TetMesh, cavity: &[u32], x: P3) -> bool {
+    let corners = |t: u32| mesh.tets[t as usize].map(|v| mesh.points[v as usize]);
     let inside = |t: u32| cavity.binary_search(&t).is_ok();
     let (faces, _) = cavity::shell(&cavity, &mesh.tets, &mesh.neighbors, inside);
     // The cone's tets first, the first one below the floor ending the test (most candidates
@@ -187,11 +225,11 @@ fn cone(mesh: &TetMesh, s: u32, x: P3, claimed: &[bool]) -> Option<Vec<u32>> {
     for f in &faces {
         let w = [f[0], f[1], f[2]].map(|v| mesh.points[v as usize]);
         if orient3d(w[0], w[1], w[2], x) != Sign::Positive {
-            return None;
+            return false;
         }
         new = new.min(min_dihedral_deg_by_chord(&[w[0], w[1], w[2], x]));
         if new < SEED_BELOW_DEG {
-            return None;
+            return false;
         }
     }
     // Every shell face seen strictly from inside makes the cone a triangulation of the cavity
@@ -217,7 +255,7 @@ fn cone(mesh: &TetMesh, s: u32, x: P3, claimed: &[bool]) -> Option<Vec<u32>> {
         .iter()
         .map(|&t| min_dihedral_deg_by_chord(&corners(t)))
         .fold(180.0, f64::min);
-    (sphere && !lost && new > old).then_some(cavity)
+    sphere && !lost && new > old
 }
 
 /// The tet of `t`'s region holding `x` strictly inside, walking from `t` through faces `x` lies
