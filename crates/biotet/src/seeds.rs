@@ -218,7 +218,7 @@ fn with_poor_neighbours(mesh: &TetMesh, cavity: &[u32], admit: impl Fn(u32) -> b
 fn cone_ok(mesh: &TetMesh, cavity: &[u32], x: P3) -> bool {
     let corners = |t: u32| mesh.tets[t as usize].map(|v| mesh.points[v as usize]);
     let inside = |t: u32| cavity.binary_search(&t).is_ok();
-    let (faces, _) = cavity::shell(&cavity, &mesh.tets, &mesh.neighbors, inside);
+    let (faces, _) = cavity::shell(cavity, &mesh.tets, &mesh.neighbors, inside);
     // The cone's tets first, the first one below the floor ending the test (most candidates
     // end so), then the cavity's.
     let mut new = 180.0f64;
