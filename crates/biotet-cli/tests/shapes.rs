@@ -32,12 +32,14 @@ fn is_invalid(p: &Path) -> bool {
         .starts_with("invalid_")
 }
 
-#[test]
-fn every_valid_shape_meshes_with_every_triangle_kept() {
+/// Mesh each of `shapes` with the defaults and check the output; the failures to mesh (each a
+/// line) and how many meshed. Every mesh written must keep every triangle and pass `check`; a
+/// failed run must write nothing.
+fn mesh_each(shapes: &[PathBuf]) -> (Vec<String>, usize) {
     let dir = tempfile::tempdir().unwrap();
     let mut failures = Vec::new();
     let mut meshed = 0;
-    for s in shapes().iter().filter(|p| !is_invalid(p)) {
+    for s in shapes {
         let name = s.file_stem().unwrap().to_string_lossy().to_string();
         let out = dir.path().join(format!("{name}.vtu"));
         let (s_str, out_str) = (s.to_str().unwrap(), out.to_str().unwrap());
@@ -74,8 +76,33 @@ fn every_valid_shape_meshes_with_every_triangle_kept() {
         assert!(steiner < 1000, "{name}: {steiner} Steiner points");
         meshed += 1;
     }
+    (failures, meshed)
+}
+
+#[test]
+fn every_valid_shape_meshes_with_every_triangle_kept() {
+    let valid: Vec<PathBuf> = shapes().into_iter().filter(|p| !is_invalid(p)).collect();
+    let (failures, meshed) = mesh_each(&valid);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
     assert!(meshed >= 40, "only {meshed} shapes");
+}
+
+/// The known failures of `tests/data/shapes/failing` (its README): valid surfaces recovery does
+/// not finish on yet (a cube of strip-cut faces, a lattice of crossing bars). Ignored until they
+/// mesh; `cargo test -p biotet-cli --test shapes -- --ignored` runs it.
+#[test]
+#[ignore = "known failures: tests/data/shapes/failing/README.md"]
+fn known_failures_mesh_with_every_triangle_kept() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/shapes/failing");
+    let mut failing: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .expect("tests/data/shapes/failing")
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "off"))
+        .collect();
+    failing.sort();
+    assert_eq!(failing.len(), 2);
+    let (failures, _) = mesh_each(&failing);
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
 #[test]
@@ -233,6 +260,39 @@ fn a_failed_recovery_lists_only_its_own_failures() {
             "{l}"
         );
     }
+    // The stages after recovery do not run (they keep only the faces between labels, which leak
+    // through the triangles left, and took recovered triangles with them on a lattice of bars):
+    // the count reported is recovery's, and the partial mesh keeps every triangle it recovered.
+    let kept = dir.path().join("kept.vtu");
+    let k = kept.to_str().unwrap();
+    let m = biotet(&[
+        "mesh",
+        s,
+        "-o",
+        k,
+        "--size",
+        "0.1225",
+        "--no-steiner",
+        "--keep-failed",
+        "--json",
+    ]);
+    assert_eq!(m.status.code(), Some(1));
+    let j: serde_json::Value = serde_json::from_slice(&m.stdout).unwrap();
+    let p = &j["pipeline"];
+    let left = p["recover"]["missing_after"].as_u64().unwrap();
+    assert!(left > 0);
+    assert_eq!(p["missing_triangles"].as_u64(), Some(left));
+    let stages: Vec<&str> = p["stages"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(stages.last(), Some(&"recover"), "{stages:?}");
+    let failed = dir.path().join("kept.failed.vtu");
+    let c = biotet(&["check", failed.to_str().unwrap(), "--surface", s, "--json"]);
+    let cj: serde_json::Value = serde_json::from_slice(&c.stdout).unwrap();
+    assert_eq!(cj["surface"]["n_missing"].as_u64(), Some(left), "{cj}");
 }
 
 /// A cube of 12 triangles meshed at a tenth of its side: kept exactly, the tets on its faces

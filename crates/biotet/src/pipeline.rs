@@ -228,25 +228,34 @@ pub fn mesh_surface<S: Borrow<Sizing>>(
         }
     }
 
-    if opts.seeds && opts.recover.is_some() {
+    // Triangles recovery left let the region labels through, and the stages after it keep only
+    // the faces between labels: they would take recovered triangles with them (a lattice of
+    // crossing bars: 7 left by recovery, 26 after sliver removal). The run fails either way;
+    // its partial mesh (`--keep-failed`) is recovery's.
+    let recovered = report.recover.as_ref().is_none_or(|r| r.missing_after == 0);
+    if opts.seeds && opts.recover.is_some() && recovered {
         progress("seeding thin sections");
         let clock = Instant::now();
         report.seeds = crate::seeds::insert_seeds(&mut mesh, ns, surface);
         stage(&mut report, "seeds", clock);
     }
-    if let Some(o) = &opts.improve {
+    if let Some(o) = opts.improve.as_ref().filter(|_| recovered) {
         progress("removing slivers");
         let clock = Instant::now();
         report.improve = Some(improve(&mut mesh, o));
         stage(&mut report, "improve", clock);
     }
-    if let Some(o) = &opts.smooth {
+    if let Some(o) = opts.smooth.as_ref().filter(|_| recovered) {
         progress("smoothing");
         let clock = Instant::now();
         report.smooth = Some(smooth(&mut mesh, Some(surface), o)?);
         stage(&mut report, "smooth", clock);
     }
-    if let Some(o) = opts.polish.as_ref().filter(|_| opts.recover.is_some()) {
+    if let Some(o) = opts
+        .polish
+        .as_ref()
+        .filter(|_| opts.recover.is_some() && recovered)
+    {
         progress("polishing");
         let clock = Instant::now();
         report.polish = Some(polish(&mut mesh, o));
