@@ -1,18 +1,18 @@
 //! Interior seeds where node deployment placed none: the circumcentres of the poor tets that
 //! join surface points across a thin section, each inserted by coning its cavity.
 //!
-//! The template keeps its nodes a sealing distance from the surface, so a section thinner than
-//! that (a square-section ring tube, a thin bar) gets no interior node, and every tet there
-//! joins surface points from wall to wall. Where such a tet is poor, the circumcentre of it or
-//! of a neighbour of the same kind (a flat tet on a planar quad has none of its own) is the point
+//! The template keeps its nodes a sealing distance from the surface, so a section thinner than that
+//! (a square-section ring tube, a thin bar) gets no interior node, and every tet there joins
+//! surface points from wall to wall. Where such a tet is poor, the circumcentre of it or of a
+//! neighbour of the same kind (a flat tet on a planar quad has none of its own) is the point
 //! Delaunay refinement would add (TetGen's `q` puts one in each segment of a square-section ring
 //! tube). It becomes a seed when it lies strictly inside the region, clear of the surface and of
 //! the points around it, and the tets whose circumspheres hold it, reached through faces of the
-//! region (with the poor tets beside them when that passes, else alone: a flat tet on a planar
-//! quad has no circumsphere to hold it), form a cavity whose every shell face sees it strictly
-//! inside (exact `orient3d`), with
-//! no point lost, and whose cone's worst dihedral angle is above [`SEED_BELOW_DEG`] and above the
-//! cavity's worst. Cavities of two seeds never share a tet; every accepted cone replaces its
+//! region (with the poor tets beside them when that passes, else alone: a flat tet on a planar quad
+//! has no circumsphere to hold it), form a cavity whose every shell face sees it strictly inside
+//! (exact `orient3d`), with no point lost, and whose cone's worst dihedral angle is above
+//! [`SEED_BELOW_DEG`] (half of it where the cavity holds a flat tet, under [`FLAT_DEG`]) and above
+//! the cavity's worst. Cavities of two seeds never share a tet; every accepted cone replaces its
 //! cavity at once. Boundary and interface faces are never crossed, so they stay faces.
 //!
 //! The choice of points is floating point, as node placement is; every tet made is checked
@@ -39,6 +39,10 @@ pub const SEED_BELOW_DEG: f64 = 10.0;
 /// square section, 0.27 for a triangular one (whose cones stay above 10°); the cone's own test
 /// is what keeps the seeds that would make slivers out.
 const SEED_CLEARANCE: f64 = 0.2;
+
+/// A cavity whose worst tet is below this (degrees) is flat: its seed's cone may be below
+/// [`SEED_BELOW_DEG`], down to half of it.
+const FLAT_DEG: f64 = 1.0;
 
 /// Steps of the walk that locates a circumcentre.
 const WALK_STEPS: usize = 64;
@@ -214,13 +218,25 @@ fn with_poor_neighbours(mesh: &TetMesh, cavity: &[u32], admit: impl Fn(u32) -> b
 
 /// Whether coning `cavity`'s shell to `x` is valid (every cone tet strictly positive, exact;
 /// the shell a sphere; every cavity point on it) and better (the cone's worst dihedral angle
-/// above [`SEED_BELOW_DEG`] and above the cavity's worst).
+/// above [`SEED_BELOW_DEG`], or half of it for a cavity holding a flat tet, and above the
+/// cavity's worst).
 fn cone_ok(mesh: &TetMesh, cavity: &[u32], x: P3) -> bool {
     let corners = |t: u32| mesh.tets[t as usize].map(|v| mesh.points[v as usize]);
     let inside = |t: u32| cavity.binary_search(&t).is_ok();
     let (faces, _) = cavity::shell(cavity, &mesh.tets, &mesh.neighbors, inside);
-    // The cone's tets first, the first one below the floor ending the test (most candidates
-    // end so), then the cavity's.
+    let old = cavity
+        .iter()
+        .map(|&t| min_dihedral_deg_by_chord(&corners(t)))
+        .fold(180.0, f64::min);
+    // A nearly flat tet (a cap on a planar quad of a thin fin, volume 1e-19) goes for a cone
+    // above half the floor: a revolved zigzag's fins had cones at 5°–9.8° refused and kept 0°
+    // tets, which a solver cannot use.
+    let floor = if old < FLAT_DEG {
+        0.5 * SEED_BELOW_DEG
+    } else {
+        SEED_BELOW_DEG
+    };
+    // The cone's tets, the first one below the floor ending the test (most candidates end so).
     let mut new = 180.0f64;
     for f in &faces {
         let w = [f[0], f[1], f[2]].map(|v| mesh.points[v as usize]);
@@ -228,7 +244,7 @@ fn cone_ok(mesh: &TetMesh, cavity: &[u32], x: P3) -> bool {
             return false;
         }
         new = new.min(min_dihedral_deg_by_chord(&[w[0], w[1], w[2], x]));
-        if new < SEED_BELOW_DEG {
+        if new < floor {
             return false;
         }
     }
@@ -251,10 +267,6 @@ fn cone_ok(mesh: &TetMesh, cavity: &[u32], x: P3) -> bool {
         .iter()
         .flat_map(|&t| mesh.tets[t as usize])
         .any(|v| on_shell.binary_search(&v).is_err());
-    let old = cavity
-        .iter()
-        .map(|&t| min_dihedral_deg_by_chord(&corners(t)))
-        .fold(180.0, f64::min);
     sphere && !lost && new > old
 }
 

@@ -383,7 +383,14 @@ impl Work {
             // A tet covers at most four shell faces, so a fill has at least a quarter of the faces
             // with no tet above the threshold below it: more than before, and no fill can pass.
             let poor = faces_without_candidate(&self.pts, &cav.shell, &cands, thr);
-            for floor in [thr, old.1.max(new.1).max(0.0) * (1.0 + 1e-9)] {
+            // A flat tet's rescue takes only fills its acceptance would keep (every tet above
+            // a hundredth of the threshold): with the cavity's worst as the floor, the search
+            // found fills through another flat tet of the same planar quad, and nothing else.
+            let mut lower = old.1.max(new.1).max(0.0) * (1.0 + 1e-9);
+            if deep {
+                lower = lower.max(DEEP_FLOOR * thr);
+            }
+            for floor in [thr, lower] {
                 if floor < thr && (large || poor.div_ceil(4) > old.2) && !deep {
                     break;
                 }
