@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Regenerate the shape corpus in tests/data/shapes/: closed triangle surfaces nobody on this project tuned biotet for.
 
-    pip install gmsh==4.15.2 trimesh==5.2.0 numpy scipy    # (pip downloads two wheels for the package meshes, below)
+    pip install gmsh==4.15.2 trimesh==5.2.0 shapely numpy scipy    # (pip downloads two wheels for the package meshes, below)
     python3 scripts/make_shapes.py [--biotet PATH] [--out DIR] [--wheels DIR]
 
 Four sources, one prefix each (the list is SHAPES below; tests/data/shapes/README.md says what each one exercises):
@@ -9,7 +9,8 @@ Four sources, one prefix each (the list is SHAPES below; tests/data/shapes/READM
   cad_*   CAD solids built here with the gmsh Python API (OpenCASCADE kernel), or read from the STEP files that ship in
           gmsh's wheel (share/doc/gmsh), surface-meshed by gmsh's default 2D mesher (one thread) at modest sizes, and
           exported as the union of the solid's face meshes, each face's triangles turned to face out of the solid.
-  tm_*    trimesh.creation primitives (box, slab, cylinder, capsule, cone, annulus, torus, icosphere).
+  tm_*    trimesh.creation primitives (box, slab, cylinder, capsule, cone, annulus, torus, icosphere, revolve,
+          extrude_polygon).
   pkg_*   closed triangle meshes shipped inside Python packages' wheels: gmsh (installed), pyvista and pymeshlab
           (their wheels are fetched with `pip download --no-deps NAME==VERSION` into --wheels, and read from the zip;
           nothing is installed).
@@ -352,6 +353,17 @@ def cad_two_balls_default():
         return m.surface_mesh()
 
 
+def cad_cup_thin():
+    """An open cup: a unit box minus an inner box 0.01 from its walls and bottom, reaching past its top (walls 0.01
+    thick); gmsh's default sizes."""
+    with Gmsh("cup") as m:
+        occ = m.g.model.occ
+        b = occ.addBox(0, 0, 0, 1, 1, 1)
+        i = occ.addBox(0.01, 0.01, 0.01, 0.98, 0.98, 2)
+        occ.cut([(3, b)], [(3, i)])
+        return m.surface_mesh()
+
+
 def cad_chamfer_box():
     """A 2-cube with four edges chamfered (0.3): planar chamfer faces; OpenCASCADE writes one zero as -7.7e-34."""
     with Gmsh("chamfer_box") as m:
@@ -520,6 +532,29 @@ def tm_hull_random200():
     import trimesh
     h = trimesh.convex.convex_hull(np.random.default_rng(200).random((200, 3)))
     return h.vertices, h.faces
+
+
+def tm_revolve_zigzag():
+    """trimesh.creation.revolve of a profile zigzagging between radii 1 and 1.3 every 0.2 (21 points, closed on the
+    axis at z = 0 and 4), 64 sections: thin fins of triangular section around a core, side quads planar trapezoids."""
+    import trimesh
+    prof = [[0.0, 0.0]] + [[1.0 + 0.3 * (i % 2), 0.2 * i] for i in range(21)] + [[0.0, 4.0]]
+    m = trimesh.creation.revolve(np.array(prof, dtype=np.float64), sections=64)
+    return np.asarray(m.vertices, dtype=np.float64), np.asarray(m.faces)
+
+
+def tm_extrude_holes():
+    """trimesh.creation.extrude_polygon of a 10 x 4 rectangle with 48 hexagonal holes (12 x 4, radii 0.25 and 0.3),
+    height 0.5: a plate whose faces are triangulated between the holes (long thin triangles, many coplanar points)."""
+    import trimesh
+    from shapely.geometry import Polygon
+    holes = []
+    for i in range(12):
+        for j in range(4):
+            cx, cy = 0.5 + i * 0.8, 0.5 + j * 1.0
+            holes.append([(cx + 0.25 * math.cos(a), cy + 0.3 * math.sin(a)) for a in np.linspace(0, 2 * np.pi, 7)[:-1]])
+    m = trimesh.creation.extrude_polygon(Polygon([(0, 0), (10, 0), (10, 4), (0, 4)], holes), height=0.5)
+    return np.asarray(m.vertices, dtype=np.float64), np.asarray(m.faces)
 
 
 def tm_capsule_turned():
@@ -716,6 +751,7 @@ SHAPES = {
                              "loft through three circles, every gmsh node written: points no triangle uses, some on "
                              "a triangle's edge"),
     "cad_chamfer_box": (cad_chamfer_box, GMSH_SRC, "generated", "chamfered edges; a zero written as -7.7e-34"),
+    "cad_cup_thin": (cad_cup_thin, GMSH_SRC, "generated", "open cup, walls 0.01 thick: every tet spans a wall"),
     "cad_component8": (cad_component8, "gmsh {gmsh} OCC, STEP component8.step from the gmsh wheel",
                        LICENCE["gmsh"], "~13k-triangle machined part: facets, holes, sharp edges"),
     "cad_component8_f32": (cad_component8_f32, "gmsh {gmsh} OCC, component8.step, coordinates rounded to float32",
@@ -767,6 +803,10 @@ SHAPES = {
     "tm_square_torus": (tm("torus", major_radius=1.0, minor_radius=0.01, major_sections=200, minor_sections=4),
                         "trimesh {trimesh} creation.torus(1, 0.01, 200, 4)", "generated",
                         "square-section ring tube: planar isosceles-trapezoid faces (cocircular quads), 200 short segments"),
+    "tm_revolve_zigzag": (tm_revolve_zigzag, "trimesh {trimesh} creation.revolve", "generated",
+                          "revolved zigzag: thin fins of triangular section, planar trapezoids (flat tets on them)"),
+    "tm_extrude_holes": (tm_extrude_holes, "trimesh {trimesh} creation.extrude_polygon (shapely)", "generated",
+                         "plate with 48 hexagonal holes: faces triangulated between the holes"),
     "tm_tri_torus": (tm("torus", major_radius=1.0, minor_radius=0.01, major_sections=200, minor_sections=3),
                      "trimesh {trimesh} creation.torus(1, 0.01, 200, 3)", "generated",
                      "triangular-section ring tube: each segment a twisted prism, its centre a quarter of its "
