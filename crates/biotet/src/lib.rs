@@ -14,6 +14,7 @@ pub mod delaunay;
 pub mod delaunay2d;
 pub mod geom;
 pub mod image;
+pub mod inset;
 pub mod lastresort;
 pub mod mesh;
 pub mod pipeline;

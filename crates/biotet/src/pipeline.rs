@@ -197,13 +197,19 @@ pub fn mesh_surface<S: Borrow<Sizing>>(
     // The nodes are kept for a retry: a surface triangle far larger than the spacing around it
     // can cross so many tets that no cavity within the bounds holds it (the Schönhardt prism
     // or two cubes at a twentieth of their size). Without the nodes near it, it can.
-    let retry = (opts.recover.is_some_and(|o| o.allow_interior_steiner)
-        && !dep.interior_regions.is_empty())
-    .then(|| (dep.points.clone(), dep.interior_regions.clone()));
+    // The nodes, kept for the fallbacks when points may be added: the retries without the nodes
+    // near the triangles recovery left, then with points just behind them.
+    let steiner = opts.recover.is_some_and(|o| o.allow_interior_steiner);
+    let mut nodes = steiner.then(|| Nodes {
+        points: dep.points.clone(),
+        regions: dep.interior_regions.clone(),
+        ns,
+    });
+    let retry = steiner && !dep.interior_regions.is_empty();
     // With nodes to clear, the first try skips the wide rounds (seconds where a retry takes
     // milliseconds); they come last, if clearing does not do.
     let first = opts.recover.map(|o| RecoverOptions {
-        widen: o.widen && retry.is_none(),
+        widen: o.widen && !retry,
         ..o
     });
     let mut mesh = tetrahedralize(
@@ -215,16 +221,18 @@ pub fn mesh_surface<S: Borrow<Sizing>>(
         &mut report,
         progress,
     )?;
-    if let (Some((points, regions)), Some(first), Some(last)) = (retry, first, opts.recover) {
+    if let (Some(nodes), Some(first), Some(last), true) = (&mut nodes, first, opts.recover, retry) {
         let clock = Instant::now();
-        let nodes = Nodes {
-            points,
-            regions,
-            ns,
-        };
         if let Some(m) = recover_again(surface, nodes, [first, last], &mut report, progress)? {
             mesh = m;
             stage(&mut report, "retry", clock);
+        }
+    }
+    if let (Some(nodes), Some(last)) = (&mut nodes, opts.recover) {
+        let clock = Instant::now();
+        if let Some(m) = recover_inset(surface, nodes, last, &mut report, progress)? {
+            mesh = m;
+            stage(&mut report, "inset", clock);
         }
     }
 
@@ -285,6 +293,9 @@ const MAX_RETRIES: usize = 5;
 pub struct RetryReport {
     /// Interior nodes removed before it.
     pub nodes_removed: usize,
+    /// Nodes added before it, just behind the triangles left and their corner neighbours
+    /// ([`crate::inset`]; the last fallback).
+    pub nodes_added: usize,
     /// Whether it was the last, with recovery's wide rounds (no node left to remove near).
     pub wide: bool,
     /// Input triangles still missing after it.
@@ -433,7 +444,7 @@ struct Nodes {
 /// wide rounds). The last mesh, or `None` when recovery left nothing missing.
 fn recover_again(
     surface: &SurfaceMesh,
-    mut nodes: Nodes,
+    nodes: &mut Nodes,
     opts: [RecoverOptions; 2],
     report: &mut MeshReport,
     progress: &mut dyn FnMut(&str),
@@ -450,7 +461,7 @@ fn recover_again(
         let mut removed = 0;
         while report.retries.len() < MAX_RETRIES {
             let balls = unrecovered_balls(left, radius);
-            removed = clear_nodes(&mut nodes, &balls);
+            removed = clear_nodes(nodes, &balls);
             radius *= 2.0;
             if removed > 0 || balls.iter().all(|b| b.1 > span) {
                 break;
@@ -470,7 +481,62 @@ fn recover_again(
         )?);
         report.retries.push(RetryReport {
             nodes_removed: removed,
+            nodes_added: 0,
             wide,
+            missing_after: again.recover.as_ref().map_or(0, |r| r.missing_after),
+        });
+        report.n_delaunay_tets = again.n_delaunay_tets;
+        report.n_centroid_tests = again.n_centroid_tests;
+        report.recover = again.recover;
+    }
+    Ok(mesh)
+}
+
+/// Rounds of [`recover_inset`] at most.
+const INSET_ROUNDS: usize = 2;
+
+/// While triangles are missing (at most [`INSET_ROUNDS`] times): a node just behind each of
+/// them and of the triangles sharing a corner with them ([`crate::inset`]), then tetrahedralize
+/// and recover again with `opts`. The nodes added stay in `nodes`.
+fn recover_inset(
+    surface: &SurfaceMesh,
+    nodes: &mut Nodes,
+    opts: RecoverOptions,
+    report: &mut MeshReport,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Option<TetMesh>, PipelineError> {
+    let mut mesh = None;
+    for _ in 0..INSET_ROUNDS {
+        let Some(left) = report.recover.as_ref().filter(|r| r.missing_after > 0) else {
+            break;
+        };
+        let tris: Vec<usize> = left.unrecovered.iter().map(|u| u.triangle).collect();
+        let added = crate::inset::points_behind(
+            surface,
+            &crate::inset::with_corner_neighbours(surface, &tris),
+        );
+        if added.is_empty() {
+            break;
+        }
+        progress("recovering again with points behind the missing triangles");
+        for &(p, region) in &added {
+            nodes.points.push(p);
+            nodes.regions.push(region);
+        }
+        let mut again = MeshReport::default();
+        mesh = Some(tetrahedralize(
+            surface,
+            nodes.points.clone(),
+            nodes.regions.clone(),
+            nodes.ns,
+            Some(&opts),
+            &mut again,
+            &mut |_| {},
+        )?);
+        report.retries.push(RetryReport {
+            nodes_removed: 0,
+            nodes_added: added.len(),
+            wide: true,
             missing_after: again.recover.as_ref().map_or(0, |r| r.missing_after),
         });
         report.n_delaunay_tets = again.n_delaunay_tets;

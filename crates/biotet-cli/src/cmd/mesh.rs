@@ -512,13 +512,23 @@ pub fn run(a: Args) -> Result<ExitCode> {
                 report.seeds
             );
         }
-        if !report.retries.is_empty() {
-            let removed: usize = report.retries.iter().map(|r| r.nodes_removed).sum();
+        let (clearing, inset): (Vec<_>, Vec<_>) =
+            report.retries.iter().partition(|r| r.nodes_added == 0);
+        if !clearing.is_empty() {
+            let removed: usize = clearing.iter().map(|r| r.nodes_removed).sum();
             text += &format!(
                 "recover: tried again {} times without the interior nodes near the triangles \
                  left ({removed} nodes removed of {}): the mesh is coarser there than asked\n",
-                report.retries.len(),
+                clearing.len(),
                 report.n_interior_nodes
+            );
+        }
+        if !inset.is_empty() {
+            let added: usize = inset.iter().map(|r| r.nodes_added).sum();
+            text += &format!(
+                "recover: tried again {} times with {added} nodes just behind the triangles left \
+                 and their neighbours (the last fallback)\n",
+                inset.len()
             );
         }
         text += &format!(
