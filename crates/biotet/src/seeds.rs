@@ -40,9 +40,10 @@ pub const SEED_BELOW_DEG: f64 = 10.0;
 /// is what keeps the seeds that would make slivers out.
 const SEED_CLEARANCE: f64 = 0.2;
 
-/// A cavity whose worst tet is below this (degrees) is flat: its seed's cone may be below
-/// [`SEED_BELOW_DEG`], down to half of it.
-const FLAT_DEG: f64 = 1.0;
+/// A cavity whose worst tet is below this (degrees; polish's flat, a thousandth of 10°) holds a
+/// flat tet: its seed's cone may be below [`SEED_BELOW_DEG`], down to half of it. (At 1°, pyvista's
+/// sphere got six more seeds near its poles and twice the sliver removal's time, for nothing.)
+const FLAT_DEG: f64 = 0.01;
 
 /// Steps of the walk that locates a circumcentre.
 const WALK_STEPS: usize = 64;
@@ -228,7 +229,7 @@ fn cone_ok(mesh: &TetMesh, cavity: &[u32], x: P3) -> bool {
         .iter()
         .map(|&t| min_dihedral_deg_by_chord(&corners(t)))
         .fold(180.0, f64::min);
-    // A nearly flat tet (a cap on a planar quad of a thin fin, volume 1e-19) goes for a cone
+    // A flat tet (a cap on a planar quad of a thin fin, volume 1e-19) goes for a cone
     // above half the floor: a revolved zigzag's fins had cones at 5°–9.8° refused and kept 0°
     // tets, which a solver cannot use.
     let floor = if old < FLAT_DEG {
