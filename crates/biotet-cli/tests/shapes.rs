@@ -8,9 +8,16 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn shapes() -> Vec<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/shapes");
+    off_files("tests/data/shapes")
+}
+
+/// The `.off` files of a folder of the repository, sorted.
+fn off_files(folder: &str) -> Vec<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .join(folder);
     let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .expect("tests/data/shapes")
+        .expect(folder)
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_some_and(|e| e == "off"))
         .collect();
@@ -92,13 +99,7 @@ fn every_valid_shape_meshes_with_every_triangle_kept() {
 /// last fallback), meshed through points just behind the triangles left (`biotet::inset`).
 #[test]
 fn hard_shapes_mesh_with_every_triangle_kept() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/shapes/hard");
-    let mut hard: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .expect("tests/data/shapes/hard")
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "off"))
-        .collect();
-    hard.sort();
+    let hard = off_files("tests/data/shapes/hard");
     assert_eq!(hard.len(), 2);
     let (failures, meshed) = mesh_each(&hard);
     assert!(failures.is_empty(), "{}", failures.join("\n"));

@@ -10,10 +10,11 @@
 //! strip-cut faces: 61 triangles left, none after 247 such points).
 //!
 //! Each point is `c - δ n`: `c` the triangle's centroid, `n` its unit normal (towards its front
-//! side), `δ` half its inradius, halved until the point is at least `δ / 2` from every other
-//! surface triangle (a thin wall behind it) and, by the exact ray-parity test of
-//! [`crate::mesh::inside`], strictly inside the region behind the triangle; never on the surface,
-//! so every triangle stays as given. Floating point chooses the place; the region test decides.
+//! side; turned where the region behind is the outside, label 0), `δ` half its inradius, halved
+//! until the point is at least `δ / 2` from every other surface triangle (a thin wall behind it)
+//! and, by the exact ray-parity test of [`crate::mesh::inside`], strictly inside the region behind
+//! the triangle; never on the surface, so every triangle stays as given. Floating point chooses the
+//! place; the region test decides.
 
 use crate::geom::vec3::{cross, norm, scale, sub};
 use crate::mesh::inside::{Location, RegionLocator};
@@ -59,9 +60,18 @@ pub fn points_behind(surface: &SurfaceMesh, tris: &[usize]) -> Vec<(P3, u32)> {
         if area2 == 0.0 || !area2.is_finite() || perimeter == 0.0 {
             continue;
         }
-        let n = scale(n, 1.0 / area2);
+        // Behind the triangle, or in front where behind is the outside (a sheet of a label
+        // image facing its region).
+        let [back, front] = surface.sides[t];
+        let (n, behind) = if back != 0 {
+            (scale(n, 1.0 / area2), back)
+        } else {
+            (scale(n, -1.0 / area2), front)
+        };
+        if behind == 0 {
+            continue;
+        }
         let centroid = [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0);
-        let behind = surface.sides[t][0];
         let mut delta = 0.5 * area2 / perimeter;
         for _ in 0..HALVINGS {
             let p = sub(centroid, scale(n, delta));
@@ -78,4 +88,33 @@ pub fn points_behind(surface: &SurfaceMesh, tris: &[usize]) -> Vec<(P3, u32)> {
     out.sort_by(|x, y| x.0.map(f64::to_bits).cmp(&y.0.map(f64::to_bits)));
     out.dedup_by(|x, y| x.0 == y.0);
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every triangle of a sphere gets a point inside it, half its inradius behind it; with the
+    /// triangles turned inward and the sides swapped (the region in front), the same points.
+    #[test]
+    fn points_lie_behind_each_triangle_in_its_region() {
+        let s = SurfaceMesh::icosphere(1.0, 1);
+        let all: Vec<usize> = (0..s.triangles.len()).collect();
+        let pts = points_behind(&s, &all);
+        assert_eq!(pts.len(), s.triangles.len());
+        for &(p, label) in &pts {
+            assert_eq!(label, 1);
+            let r = norm(p);
+            assert!(r < 1.0 && r > 0.8, "{r}");
+        }
+        let mut turned = s.clone();
+        for (t, sides) in turned.triangles.iter_mut().zip(turned.sides.iter_mut()) {
+            t.swap(1, 2);
+            *sides = [0, 1];
+        }
+        assert_eq!(points_behind(&turned, &all), pts);
+        // Corner neighbours of one triangle: itself and those sharing a corner with it.
+        let near = with_corner_neighbours(&s, &[0]);
+        assert!(near.contains(&0) && near.len() > 3 && near.len() < 16);
+    }
 }

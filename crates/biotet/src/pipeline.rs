@@ -469,26 +469,47 @@ fn recover_again(
         }
         wide = removed == 0;
         progress("recovering again without the nodes near the missing triangles");
-        let mut again = MeshReport::default();
-        mesh = Some(tetrahedralize(
-            surface,
-            nodes.points.clone(),
-            nodes.regions.clone(),
-            nodes.ns,
-            Some(&opts[wide as usize]),
-            &mut again,
-            &mut |_| {},
-        )?);
-        report.retries.push(RetryReport {
+        let retry = RetryReport {
             nodes_removed: removed,
             nodes_added: 0,
             wide,
-            missing_after: again.recover.as_ref().map_or(0, |r| r.missing_after),
-        });
-        report.n_delaunay_tets = again.n_delaunay_tets;
-        report.n_centroid_tests = again.n_centroid_tests;
-        report.recover = again.recover;
+            missing_after: 0,
+        };
+        mesh = Some(retry_once(
+            surface,
+            nodes,
+            &opts[wide as usize],
+            retry,
+            report,
+        )?);
     }
+    Ok(mesh)
+}
+
+/// Tetrahedralize `nodes` and recover with `opts` once more; `retry` (its `missing_after` filled
+/// in) goes to the report, whose recovery figures become this try's.
+fn retry_once(
+    surface: &SurfaceMesh,
+    nodes: &Nodes,
+    opts: &RecoverOptions,
+    mut retry: RetryReport,
+    report: &mut MeshReport,
+) -> Result<TetMesh, PipelineError> {
+    let mut again = MeshReport::default();
+    let mesh = tetrahedralize(
+        surface,
+        nodes.points.clone(),
+        nodes.regions.clone(),
+        nodes.ns,
+        Some(opts),
+        &mut again,
+        &mut |_| {},
+    )?;
+    retry.missing_after = again.recover.as_ref().map_or(0, |r| r.missing_after);
+    report.retries.push(retry);
+    report.n_delaunay_tets = again.n_delaunay_tets;
+    report.n_centroid_tests = again.n_centroid_tests;
+    report.recover = again.recover;
     Ok(mesh)
 }
 
@@ -523,25 +544,13 @@ fn recover_inset(
             nodes.points.push(p);
             nodes.regions.push(region);
         }
-        let mut again = MeshReport::default();
-        mesh = Some(tetrahedralize(
-            surface,
-            nodes.points.clone(),
-            nodes.regions.clone(),
-            nodes.ns,
-            Some(&opts),
-            &mut again,
-            &mut |_| {},
-        )?);
-        report.retries.push(RetryReport {
+        let retry = RetryReport {
             nodes_removed: 0,
             nodes_added: added.len(),
             wide: true,
-            missing_after: again.recover.as_ref().map_or(0, |r| r.missing_after),
-        });
-        report.n_delaunay_tets = again.n_delaunay_tets;
-        report.n_centroid_tests = again.n_centroid_tests;
-        report.recover = again.recover;
+            missing_after: 0,
+        };
+        mesh = Some(retry_once(surface, nodes, &opts, retry, report)?);
     }
     Ok(mesh)
 }
