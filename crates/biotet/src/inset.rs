@@ -43,17 +43,11 @@ pub fn with_corner_neighbours(surface: &SurfaceMesh, tris: &[usize]) -> Vec<usiz
 /// region's label; a triangle whose point cannot be placed (a wall thinner than its offsets)
 /// gives none.
 pub fn points_behind(surface: &SurfaceMesh, tris: &[usize]) -> Vec<(P3, u32)> {
-    let corners: Vec<[P3; 3]> = surface
-        .triangles
-        .iter()
-        .map(|t| t.map(|v| surface.points[v as usize]))
-        .collect();
-    let ids = (0..corners.len() as u32).collect();
-    let bvh = Bvh::new(corners.clone(), ids);
+    let bvh = Bvh::of_surface(surface);
     let locator = RegionLocator::new(surface);
     let mut out: Vec<(P3, u32)> = Vec::with_capacity(tris.len());
     for &t in tris {
-        let [a, b, c] = corners[t];
+        let [a, b, c] = surface.corners(t);
         let n = cross(sub(b, a), sub(c, a));
         let area2 = norm(n);
         let perimeter = norm(sub(b, a)) + norm(sub(c, b)) + norm(sub(a, c));

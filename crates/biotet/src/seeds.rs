@@ -121,13 +121,7 @@ fn choose(mesh: &TetMesh, ns: usize, surface: &SurfaceMesh) -> Vec<Seed> {
     if bad.is_empty() {
         return Vec::new();
     }
-    let tris: Vec<[P3; 3]> = surface
-        .triangles
-        .iter()
-        .map(|t| t.map(|v| surface.points[v as usize]))
-        .collect();
-    let ids = (0..tris.len() as u32).collect();
-    let bvh = Bvh::new(tris, ids);
+    let bvh = Bvh::of_surface(surface);
     let mut claimed = vec![false; mesh.tets.len()];
     let mut seeds: Vec<Seed> = Vec::new();
     for t in bad {

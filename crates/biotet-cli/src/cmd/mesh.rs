@@ -517,18 +517,20 @@ pub fn run(a: Args) -> Result<ExitCode> {
         if !clearing.is_empty() {
             let removed: usize = clearing.iter().map(|r| r.nodes_removed).sum();
             text += &format!(
-                "recover: tried again {} times without the interior nodes near the triangles \
-                 left ({removed} nodes removed of {}): the mesh is coarser there than asked\n",
+                "recover: tried again without the interior nodes near the triangles left ({} {}, \
+                 {removed} nodes removed of {}): the mesh is coarser there than asked\n",
                 clearing.len(),
+                if clearing.len() == 1 { "time" } else { "times" },
                 report.n_interior_nodes
             );
         }
         if !inset.is_empty() {
             let added: usize = inset.iter().map(|r| r.nodes_added).sum();
             text += &format!(
-                "recover: tried again {} times with {added} nodes just behind the triangles left \
-                 and their neighbours (the last fallback)\n",
-                inset.len()
+                "recover: tried again with {added} nodes just behind the triangles left and their \
+                 neighbours ({} {}; the last fallback)\n",
+                inset.len(),
+                if inset.len() == 1 { "time" } else { "times" }
             );
         }
         text += &format!(

@@ -283,6 +283,13 @@ pub fn unit_normal(t: &[P3; 3]) -> P3 {
 }
 
 impl Bvh {
+    /// Index every triangle of `s`, each answering with its index.
+    pub fn of_surface(s: &crate::mesh::surface::SurfaceMesh) -> Bvh {
+        let tris: Vec<[P3; 3]> = (0..s.triangles.len()).map(|t| s.corners(t)).collect();
+        let ids = (0..tris.len() as u32).collect();
+        Bvh::new(tris, ids)
+    }
+
     /// Index the given triangles; `ids[i]` is what a query returns for `tris[i]`.
     pub fn new(tris: Vec<[P3; 3]>, ids: Vec<u32>) -> Bvh {
         assert_eq!(tris.len(), ids.len());
