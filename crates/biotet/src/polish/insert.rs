@@ -156,14 +156,13 @@ impl Work {
     /// exactly by [`Self::insert_into`].
     fn circumsphere_cavity(&self, t: u32, x: P3, max: usize) -> Option<Vec<u32>> {
         let label = self.labels[t as usize];
-        let this = self;
         crate::mesh::cavity::circumsphere_cavity(
             t,
             x,
             max,
-            &this.nb,
-            |n| this.corners(n),
-            |n| !this.outside(label, n) && !this.forced_now(n),
+            &self.nb,
+            |n| self.corners(n),
+            |n| !self.outside(label, n) && !self.forced_now(n),
         )
     }
 
