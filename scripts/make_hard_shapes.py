@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Write tests/data/shapes/hard/: valid closed surfaces that LAST RESORT recovery does not finish on, which mesh only
-through the pipeline's last fallback (points just behind the triangles left, `biotet::inset`), slowly (found in
-session 35's hunt on shapes nobody tuned for; tests/data/shapes/hard/README.md).
+through the pipeline's fallbacks: the cubes as cones from their centre (`biotet::star`), the lattice through points
+just behind the triangles left (`biotet::inset`), slowly (found in session 35's hunt on shapes nobody tuned for;
+tests/data/shapes/hard/README.md).
 
     pip install numpy manifold3d==3.5.4
     python3 scripts/make_hard_shapes.py [--out DIR]
@@ -9,10 +10,11 @@ session 35's hunt on shapes nobody tuned for; tests/data/shapes/hard/README.md).
   gen_cube_strips35  a unit cube, each side face cut into 35 strips parallel to z (two triangles each); the top and
                      bottom faces cut into 35 strips parallel to y, the two end strips of each fanned over the 36
                      collinear points of the side face beside them. Pure Python.
+  gen_cube_strips100 the same with 100 strips a face (1,596 triangles).
   tm_lattice2_f64    manifold3d's union of 2 × 2 × 2 crossing bars (twelve 12-sided cylinders, radius 0.08, length
                      4), its float64 mesh (`to_mesh64`): genus 5, 1,296 triangles.
 
-Both are written as OFF with Python's repr coordinates (exactly equal points welded), as scripts/make_shapes.py does.
+All are written as OFF with Python's repr coordinates (exactly equal points welded), as scripts/make_shapes.py does.
 """
 import argparse, os, sys
 
@@ -79,7 +81,12 @@ def main():
     ap.add_argument("--out", default=os.path.join(ROOT, "tests", "data", "shapes", "hard"))
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
-    for name, make in (("gen_cube_strips35", gen_cube_strips), ("tm_lattice2_f64", tm_lattice)):
+    shapes = (
+        ("gen_cube_strips35", gen_cube_strips),
+        ("gen_cube_strips100", lambda: gen_cube_strips(100)),
+        ("tm_lattice2_f64", tm_lattice),
+    )
+    for name, make in shapes:
         p, t = make()
         write_off(os.path.join(args.out, name + ".off"), p, t)
         print(f"{name}: {len(t)} triangles, {len(p)} points")

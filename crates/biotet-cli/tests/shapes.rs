@@ -42,10 +42,10 @@ fn is_invalid(p: &Path) -> bool {
 /// Mesh each of `shapes` with the defaults and check the output; the failures to mesh (each a
 /// line) and how many meshed. Every mesh written must keep every triangle and pass `check`; a
 /// failed run must write nothing.
-fn mesh_each(shapes: &[PathBuf]) -> (Vec<String>, usize) {
+fn mesh_each(shapes: &[PathBuf]) -> (Vec<String>, Vec<(String, serde_json::Value)>) {
     let dir = tempfile::tempdir().unwrap();
     let mut failures = Vec::new();
-    let mut meshed = 0;
+    let mut meshed = Vec::new();
     for s in shapes {
         let name = s.file_stem().unwrap().to_string_lossy().to_string();
         let out = dir.path().join(format!("{name}.vtu"));
@@ -81,7 +81,7 @@ fn mesh_each(shapes: &[PathBuf]) -> (Vec<String>, usize) {
         // Steiner points are interior: the output's points are the surface's, the interior
         // nodes and those (the check above finds every triangle with its own corners).
         assert!(steiner < 1000, "{name}: {steiner} Steiner points");
-        meshed += 1;
+        meshed.push((name, j));
     }
     (failures, meshed)
 }
@@ -91,19 +91,36 @@ fn every_valid_shape_meshes_with_every_triangle_kept() {
     let valid: Vec<PathBuf> = shapes().into_iter().filter(|p| !is_invalid(p)).collect();
     let (failures, meshed) = mesh_each(&valid);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
-    assert!(meshed >= 40, "only {meshed} shapes");
+    assert!(meshed.len() >= 40, "only {} shapes", meshed.len());
 }
 
 /// `tests/data/shapes/hard` (its README): valid surfaces LAST RESORT recovery does not finish on
-/// (a cube of strip-cut faces, a lattice of crossing bars; 61 and 8 triangles left before the
-/// last fallback), meshed through points just behind the triangles left (`biotet::inset`).
+/// (two cubes of strip-cut faces, a lattice of crossing bars), meshed through the fallbacks: the
+/// cubes as cones from their centre (`biotet::star`), the lattice through points just behind the
+/// triangles left (`biotet::inset`).
 #[test]
 fn hard_shapes_mesh_with_every_triangle_kept() {
     let hard = off_files("tests/data/shapes/hard");
-    assert_eq!(hard.len(), 2);
+    assert_eq!(hard.len(), 3);
     let (failures, meshed) = mesh_each(&hard);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
-    assert_eq!(meshed, 2);
+    assert_eq!(meshed.len(), 3);
+    // The strip-cut cubes are convex: coned from their centre where recovery leaves triangles
+    // (with 100 strips a face, 499 were left after every other fallback and the run failed;
+    // with 35, the points behind them made 2,541 tets under 10° and one of 0.0002°).
+    for (name, j) in meshed
+        .iter()
+        .filter(|(n, _)| n.starts_with("gen_cube_strips"))
+    {
+        let star = &j["pipeline"]["star"];
+        assert!(
+            star["triangles_left_by_recovery"].as_u64().unwrap() > 0,
+            "{name}: {star}"
+        );
+        assert_eq!(star["regions"], 1, "{name}");
+        let min = j["quality"]["min_dihedral_deg"].as_f64().unwrap();
+        assert!(min > 0.005, "{name}: smallest dihedral angle {min}°");
+    }
 }
 
 #[test]

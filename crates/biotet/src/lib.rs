@@ -27,6 +27,7 @@ pub mod seeds;
 pub mod sizing;
 pub mod sizing_grid;
 pub mod smooth;
+pub mod star;
 pub mod surface;
 pub mod template;
 pub mod text;

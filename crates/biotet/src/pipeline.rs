@@ -129,6 +129,9 @@ pub struct MeshReport {
     pub recover: Option<RecoverReport>,
     /// Retries of recovery without the interior nodes near the triangles it left, in order.
     pub retries: Vec<RetryReport>,
+    /// Where recovery and its retries left triangles and every region is star-shaped: the
+    /// regions coned from interior points instead ([`crate::star`]).
+    pub star: Option<crate::star::StarReport>,
     /// Interior seeds added in thin sections after recovery ([`crate::seeds`]).
     pub seeds: usize,
     /// What sliver removal did (if it ran).
@@ -205,11 +208,19 @@ pub fn mesh_surface<S: Borrow<Sizing>>(
         regions: dep.interior_regions.clone(),
         ns,
     });
-    let retry = steiner && !dep.interior_regions.is_empty();
+    // Where every region is star-shaped, the cones of `crate::star` follow a first try that
+    // leaves triangles, in place of the retries and the wide rounds (seconds of search on a cube
+    // of strip-cut faces, where the cones take milliseconds and keep every node).
+    let kernels = if steiner {
+        crate::star::kernels(surface)
+    } else {
+        None
+    };
+    let retry = steiner && !dep.interior_regions.is_empty() && kernels.is_none();
     // With nodes to clear, the first try skips the wide rounds (seconds where a retry takes
     // milliseconds); they come last, if clearing does not do.
     let first = opts.recover.map(|o| RecoverOptions {
-        widen: o.widen && !retry,
+        widen: o.widen && !retry && kernels.is_none(),
         ..o
     });
     let mut mesh = tetrahedralize(
@@ -227,6 +238,11 @@ pub fn mesh_surface<S: Borrow<Sizing>>(
             mesh = m;
             stage(&mut report, "retry", clock);
         }
+    }
+    if let (Some(nodes), Some(kernels)) = (&nodes, &kernels)
+        && let Some(m) = recover_star(surface, kernels, nodes, &mut report, progress)
+    {
+        mesh = m;
     }
     if let (Some(nodes), Some(last)) = (&mut nodes, opts.recover) {
         let clock = Instant::now();
@@ -553,6 +569,39 @@ fn recover_inset(
         mesh = Some(retry_once(surface, nodes, &opts, retry, report)?);
     }
     Ok(mesh)
+}
+
+/// Where recovery leaves triangles and every region is star-shaped from its point in `kernels`
+/// ([`crate::star`]): the regions coned from those points with `nodes` put back. Recovery's
+/// report then describes that mesh (nothing missing, the cone points counted as Steiner
+/// points); `report.star` says how many triangles recovery had left.
+fn recover_star(
+    surface: &SurfaceMesh,
+    kernels: &[Option<[f64; 3]>],
+    nodes: &Nodes,
+    report: &mut MeshReport,
+    progress: &mut dyn FnMut(&str),
+) -> Option<TetMesh> {
+    let r = report.recover.as_mut().filter(|r| r.missing_after > 0)?;
+    let clock = Instant::now();
+    progress("coning the star-shaped regions");
+    let (mesh, mut star) =
+        crate::star::coned(surface, kernels, &nodes.points, &nodes.regions, nodes.ns);
+    star.triangles_left_by_recovery = r.missing_after;
+    r.missing_after = 0;
+    r.unrecovered.clear();
+    r.steiner_points = star.regions;
+    r.tets_after = mesh.tets.len();
+    report.star = Some(star);
+    let TetMesh {
+        points,
+        tets,
+        neighbors,
+        labels,
+    } = mesh;
+    let mesh = compact(points, tets, neighbors, labels);
+    stage(report, "star", clock);
+    Some(mesh)
 }
 
 /// Balls around the triangles recovery left (centroid, `factor` times the farthest corner's

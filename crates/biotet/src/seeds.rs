@@ -58,8 +58,8 @@ pub fn insert_seeds(mesh: &mut TetMesh, ns: usize, surface: &SurfaceMesh) -> usi
     let n = seeds.len();
     // A cone may have fewer tets than its cavity: the slots left over go at the end.
     let mut dead: Vec<u32> = Vec::new();
-    for seed in seeds {
-        cone_in(mesh, seed, &mut dead);
+    for (x, cavity) in seeds {
+        cavity::cone_in(mesh, x, &cavity, &mut dead);
     }
     if !dead.is_empty() {
         let mut keep = vec![true; mesh.tets.len()];
@@ -75,35 +75,6 @@ pub fn insert_seeds(mesh: &mut TetMesh, ns: usize, surface: &SurfaceMesh) -> usi
         retain_tets(tets, neighbors, labels, &keep);
     }
     n
-}
-
-/// Replace a seed's cavity by its cone, adjacency kept ([`crate::mesh::cavity`]): the cone's
-/// tets take the cavity's slots in order, then new ones; slots left over are added to `dead`.
-fn cone_in(mesh: &mut TetMesh, (x, cavity): Seed, dead: &mut Vec<u32>) {
-    let p = mesh.points.len() as u32;
-    mesh.points.push(x);
-    let label = mesh.labels[cavity[0] as usize];
-    let inside = |t: u32| cavity.binary_search(&t).is_ok();
-    let (faces, outer) = cavity::shell(&cavity, &mesh.tets, &mesh.neighbors, inside);
-    let mut ids = Vec::with_capacity(faces.len());
-    for (j, f) in faces.iter().enumerate() {
-        // The shell's faces point into the cavity, at x.
-        let tet = [f[0], f[1], f[2], p];
-        match cavity.get(j) {
-            Some(&s) => {
-                mesh.tets[s as usize] = tet;
-                ids.push(s);
-            }
-            None => {
-                ids.push(mesh.tets.len() as u32);
-                mesh.tets.push(tet);
-                mesh.labels.push(label);
-                mesh.neighbors.push([NO_NEIGHBOR; 4]);
-            }
-        }
-    }
-    dead.extend(cavity.iter().skip(faces.len()));
-    cavity::stitch(&mesh.tets, &mut mesh.neighbors, &ids, &faces, &outer);
 }
 
 /// A seed: its point and its cavity's tets (sorted).
@@ -211,8 +182,7 @@ fn with_poor_neighbours(mesh: &TetMesh, cavity: &[u32], admit: impl Fn(u32) -> b
     out
 }
 
-/// Whether coning `cavity`'s shell to `x` is valid (every cone tet strictly positive, exact;
-/// the shell a sphere; every cavity point on it) and better (the cone's worst dihedral angle
+/// Whether coning `cavity`'s shell to `x` is valid ([`cavity::cone_valid`]) and better (the cone's worst dihedral angle
 /// above [`SEED_BELOW_DEG`], or half of it for a cavity holding a flat tet, and above the
 /// cavity's worst).
 fn cone_ok(mesh: &TetMesh, cavity: &[u32], x: P3) -> bool {
@@ -235,34 +205,12 @@ fn cone_ok(mesh: &TetMesh, cavity: &[u32], x: P3) -> bool {
     let mut new = 180.0f64;
     for f in &faces {
         let w = [f[0], f[1], f[2]].map(|v| mesh.points[v as usize]);
-        if orient3d(w[0], w[1], w[2], x) != Sign::Positive {
-            return false;
-        }
         new = new.min(min_dihedral_deg_by_chord(&[w[0], w[1], w[2], x]));
         if new < floor {
             return false;
         }
     }
-    // Every shell face seen strictly from inside makes the cone a triangulation of the cavity
-    // only if the shell is a sphere (a shell wrapped twice around x passes that test too): every
-    // edge on two faces, and V - E + F = 2 (the shell is embedded and closed, so connected).
-    let mut edges: Vec<[u32; 2]> = faces
-        .iter()
-        .flat_map(|f| [(f[0], f[1]), (f[1], f[2]), (f[0], f[2])])
-        .map(|(a, b)| [a.min(b), a.max(b)])
-        .collect();
-    edges.sort_unstable();
-    let manifold = edges.chunks(2).all(|e| e.len() == 2 && e[0] == e[1])
-        && edges.windows(3).all(|w| !(w[0] == w[1] && w[1] == w[2]));
-    let mut on_shell: Vec<u32> = faces.iter().flatten().copied().collect();
-    on_shell.sort_unstable();
-    on_shell.dedup();
-    let sphere = manifold && on_shell.len() + faces.len() == edges.len() / 2 + 2;
-    let lost = cavity
-        .iter()
-        .flat_map(|&t| mesh.tets[t as usize])
-        .any(|v| on_shell.binary_search(&v).is_err());
-    sphere && !lost && new > old
+    new > old && cavity::cone_valid(mesh, cavity, &faces, x)
 }
 
 /// The tet of `t`'s region holding `x` strictly inside, walking from `t` through faces `x` lies

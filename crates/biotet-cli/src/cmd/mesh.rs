@@ -524,6 +524,20 @@ pub fn run(a: Args) -> Result<ExitCode> {
                 report.n_interior_nodes
             );
         }
+        if let Some(s) = &report.star {
+            text += &format!(
+                "recover: {} triangles left; every region is star-shaped, so each was coned from \
+                 one interior point ({} in all) and the {} interior nodes put back{}\n",
+                s.triangles_left_by_recovery,
+                s.regions,
+                s.nodes_inserted,
+                if s.nodes_left_out > 0 {
+                    format!(" ({} left out, on a face)", s.nodes_left_out)
+                } else {
+                    String::new()
+                }
+            );
+        }
         if !inset.is_empty() {
             let added: usize = inset.iter().map(|r| r.nodes_added).sum();
             text += &format!(

@@ -4,10 +4,11 @@
 
 use rustc_hash::{FxHashMap, FxHashSet};
 
+use crate::geom::predicates::{Sign, orient3d};
 use crate::geom::vec3::{norm2, sub};
 use crate::quality::tet::circumcentre;
 
-use super::tet::{NO_NEIGHBOR, TET_FACES};
+use super::tet::{NO_NEIGHBOR, TET_FACES, TetMesh};
 
 /// The shell of the tets `cavity` (`inside(t)`: `t` is one of them): each face with no cavity
 /// tet across, turned to point into the cavity, with the tet across it and that tet's local face
@@ -114,6 +115,69 @@ pub fn circumsphere_cavity(
     }
     out.sort_unstable();
     Some(out)
+}
+
+/// Whether coning the tets `cavity` (sorted; `faces` their [`shell`]) to `x` makes a
+/// triangulation of it: every cone tet strictly positive (exact), the shell a sphere (a shell
+/// wrapped twice around `x` passes the first test too), and every cavity point on it.
+pub fn cone_valid(mesh: &TetMesh, cavity: &[u32], faces: &[[u32; 3]], x: [f64; 3]) -> bool {
+    let positive = faces.iter().all(|f| {
+        let w = f.map(|v| mesh.points[v as usize]);
+        orient3d(w[0], w[1], w[2], x) == Sign::Positive
+    });
+    if !positive {
+        return false;
+    }
+    // A sphere: every edge on two faces, and V - E + F = 2 (the shell is embedded and closed,
+    // so connected).
+    let mut edges: Vec<[u32; 2]> = faces
+        .iter()
+        .flat_map(|f| [(f[0], f[1]), (f[1], f[2]), (f[0], f[2])])
+        .map(|(a, b)| [a.min(b), a.max(b)])
+        .collect();
+    edges.sort_unstable();
+    let manifold = edges.chunks(2).all(|e| e.len() == 2 && e[0] == e[1])
+        && edges.windows(3).all(|w| !(w[0] == w[1] && w[1] == w[2]));
+    let mut on_shell: Vec<u32> = faces.iter().flatten().copied().collect();
+    on_shell.sort_unstable();
+    on_shell.dedup();
+    let sphere = manifold && on_shell.len() + faces.len() == edges.len() / 2 + 2;
+    sphere
+        && cavity
+            .iter()
+            .flat_map(|&t| mesh.tets[t as usize])
+            .all(|v| on_shell.binary_search(&v).is_ok())
+}
+
+/// Add point `x` and replace the tets `cavity` (sorted) by the cone of their shell to it,
+/// adjacency kept: the cone's tets take the cavity's slots in order, then new ones; slots left
+/// over are added to `dead` (for [`super::tet::retain_tets`]). The caller has checked the cone
+/// ([`cone_valid`]).
+pub fn cone_in(mesh: &mut TetMesh, x: [f64; 3], cavity: &[u32], dead: &mut Vec<u32>) {
+    let p = mesh.points.len() as u32;
+    mesh.points.push(x);
+    let label = mesh.labels[cavity[0] as usize];
+    let inside = |t: u32| cavity.binary_search(&t).is_ok();
+    let (faces, outer) = shell(cavity, &mesh.tets, &mesh.neighbors, inside);
+    let mut ids = Vec::with_capacity(faces.len());
+    for (j, f) in faces.iter().enumerate() {
+        // The shell's faces point into the cavity, at x.
+        let tet = [f[0], f[1], f[2], p];
+        match cavity.get(j) {
+            Some(&s) => {
+                mesh.tets[s as usize] = tet;
+                ids.push(s);
+            }
+            None => {
+                ids.push(mesh.tets.len() as u32);
+                mesh.tets.push(tet);
+                mesh.labels.push(label);
+                mesh.neighbors.push([NO_NEIGHBOR; 4]);
+            }
+        }
+    }
+    dead.extend(cavity.iter().skip(faces.len()));
+    stitch(&mesh.tets, &mut mesh.neighbors, &ids, &faces, &outer);
 }
 
 #[cfg(test)]
