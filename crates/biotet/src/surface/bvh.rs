@@ -154,25 +154,9 @@ fn within_d2_pre(p: P3, t: &[P3; 3], pre: &Pre, r: f64, r2: f64) -> Option<f64> 
     within_d2_plane(p, t, pre.n, pre.nn, r2)
 }
 
-/// Where on triangle `[a, b, c]` the point closest to `p` lies ([`closest_part`]).
-enum Part {
-    /// Corner `a`, `b` or `c` (0, 1, 2).
-    Corner(usize),
-    /// On edge `ab` at `a + s (b - a)`.
-    Ab(f64),
-    /// On edge `ac` at `a + s (c - a)`.
-    Ac(f64),
-    /// On edge `bc` at `b + s (c - b)`.
-    Bc(f64),
-    /// Inside, at `a + v (b - a) + w (c - a)`.
-    Face(f64, f64),
-    /// A degenerate triangle: on edge `k` (`ab`, `bc`, `ca`) at `s` along it.
-    Edge(usize, f64),
-}
-
-/// The part of triangle `t` closest to `p` (Voronoi regions of the corners, edges and face,
+/// The closest point of triangle `t` to `p` (Voronoi regions of the corners, edges and face,
 /// tested in turn with barycentric dot products).
-fn closest_part(p: P3, t: &[P3; 3]) -> Part {
+pub fn closest_on_triangle(p: P3, t: &[P3; 3]) -> P3 {
     let [a, b, c] = *t;
     let ab = sub(b, a);
     let ac = sub(c, a);
@@ -180,93 +164,53 @@ fn closest_part(p: P3, t: &[P3; 3]) -> Part {
     let d1 = dot(ab, ap);
     let d2 = dot(ac, ap);
     if d1 <= 0.0 && d2 <= 0.0 {
-        return Part::Corner(0);
+        return a;
     }
     let bp = sub(p, b);
     let d3 = dot(ab, bp);
     let d4 = dot(ac, bp);
     if d3 >= 0.0 && d4 <= d3 {
-        return Part::Corner(1);
+        return b;
     }
     let vc = d1 * d4 - d3 * d2;
     if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return Part::Ab(d1 / (d1 - d3));
+        let v = d1 / (d1 - d3);
+        return add(a, scale(ab, v));
     }
     let cp = sub(p, c);
     let d5 = dot(ab, cp);
     let d6 = dot(ac, cp);
     if d6 >= 0.0 && d5 <= d6 {
-        return Part::Corner(2);
+        return c;
     }
     let vb = d5 * d2 - d1 * d6;
     if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return Part::Ac(d2 / (d2 - d6));
+        let w = d2 / (d2 - d6);
+        return add(a, scale(ac, w));
     }
     let va = d3 * d6 - d5 * d4;
     if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return Part::Bc((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return add(b, scale(sub(c, b), w));
     }
     let denom = va + vb + vc;
     if denom == 0.0 || !denom.is_finite() {
         // Degenerate triangle: the best of its three edges.
-        let mut best = Part::Corner(0);
+        let mut best = a;
         let mut bd = f64::INFINITY;
-        for (k, (u, v)) in [(a, b), (b, c), (c, a)].into_iter().enumerate() {
-            let d = sub(v, u);
-            let l = dot(d, d);
-            let s = if l == 0.0 {
-                0.0
-            } else {
-                (dot(sub(p, u), d) / l).clamp(0.0, 1.0)
-            };
-            let q = add(u, scale(d, s));
-            let e = dist2(p, q);
-            if e < bd {
-                bd = e;
-                best = Part::Edge(k, s);
+        for (u, v) in [(a, b), (b, c), (c, a)] {
+            let q = closest_on_segment(p, u, v);
+            let d = dist2(p, q);
+            if d < bd {
+                bd = d;
+                best = q;
             }
         }
         return best;
     }
-    Part::Face(vb / denom, vc / denom)
-}
-
-/// The closest point of triangle `t` to `p`.
-pub fn closest_on_triangle(p: P3, t: &[P3; 3]) -> P3 {
-    let [a, b, c] = *t;
-    match closest_part(p, t) {
-        Part::Corner(k) => t[k],
-        Part::Ab(s) => add(a, scale(sub(b, a), s)),
-        Part::Ac(s) => add(a, scale(sub(c, a), s)),
-        Part::Bc(s) => add(b, scale(sub(c, b), s)),
-        Part::Face(v, w) => add(a, add(scale(sub(b, a), v), scale(sub(c, a), w))),
-        Part::Edge(k, s) => {
-            let (u, v) = (t[k], t[(k + 1) % 3]);
-            add(u, scale(sub(v, u), s))
-        }
-    }
-}
-
-/// The barycentric weights (of `t`'s corners, in order) of the point of triangle `t` closest to
-/// `p`: moving corner `k` by `m` moves that point by `w[k] m`.
-pub fn closest_weights(p: P3, t: &[P3; 3]) -> [f64; 3] {
-    match closest_part(p, t) {
-        Part::Corner(k) => {
-            let mut w = [0.0; 3];
-            w[k] = 1.0;
-            w
-        }
-        Part::Ab(s) => [1.0 - s, s, 0.0],
-        Part::Ac(s) => [1.0 - s, 0.0, s],
-        Part::Bc(s) => [0.0, 1.0 - s, s],
-        Part::Face(v, w) => [1.0 - v - w, v, w],
-        Part::Edge(k, s) => {
-            let mut w = [0.0; 3];
-            w[k] = 1.0 - s;
-            w[(k + 1) % 3] = s;
-            w
-        }
-    }
+    let v = vb / denom;
+    let w = vc / denom;
+    add(a, add(scale(ab, v), scale(ac, w)))
 }
 
 /// The squared distance from `p` to triangle `t` if it is at most `r2` (`r` its root), else

@@ -27,8 +27,8 @@
 use rustc_hash::{FxHashMap, FxHashSet};
 
 use super::bvh::{
-    Hint, PatchIndex, closest_on_segment, closest_on_triangle, closest_weights, dist2,
-    longest_edge, unit_normal, within, within_d2,
+    Hint, PatchIndex, closest_on_segment, closest_on_triangle, dist2, longest_edge, unit_normal,
+    within, within_d2,
 };
 use super::features::{Features, key};
 use super::grid::Grid;
@@ -85,11 +85,6 @@ pub fn min_angle_deg(t: &[P3; 3]) -> f64 {
     }
 }
 
-/// An input sample's new cover: the sample, its triangle, an upper bound on its distance to
-/// it, and the barycentric weights (of the triangle's corners in order) of a point of the
-/// triangle within that bound of the sample.
-type Cover = (u32, u32, f64, [f64; 3]);
-
 /// A checked point move ([`Remesher::check_move`]): the point, where it goes, its new target
 /// size (a relaxation takes the input's there), its fan's new distance bounds and the input
 /// samples' new covers.
@@ -98,7 +93,7 @@ struct Move {
     x: P3,
     size: Option<f64>,
     devs: Vec<(f64, u8)>,
-    plan: Vec<Cover>,
+    plan: Vec<(u32, u32, f64)>,
 }
 
 /// A checked edge collapse ([`Remesher::check_collapse`]): `a` goes, `b` stays (at `x`); the
@@ -111,7 +106,7 @@ struct Collapse {
     dead: [u32; 2],
     kept: Vec<(u32, [u32; 3])>,
     devs: Vec<(f64, u8)>,
-    plan: Vec<Cover>,
+    plan: Vec<(u32, u32, f64)>,
 }
 
 /// A checked edge flip ([`Remesher::check_flip`]).
@@ -125,7 +120,7 @@ enum Flip {
         t: [u32; 2],
         tris: [[u32; 3]; 2],
         devs: Vec<(f64, u8)>,
-        plan: Vec<Cover>,
+        plan: Vec<(u32, u32, f64)>,
     },
 }
 
@@ -177,9 +172,6 @@ pub struct Remesher<'a> {
     /// Per input sample: the triangle that covers it (within the working tolerance) and an
     /// upper bound on its distance to it.
     cover: Vec<(u32, f64)>,
-    /// Per input sample: the barycentric weights of a point of its triangle within the bound of
-    /// it (`[1, 1, 1]`: unknown), so a move of corner `k` by `m` keeps it within `bound + w[k] m`.
-    cover_w: Vec<[f64; 3]>,
     /// Per triangle: the input samples it covers.
     covers: Vec<Vec<u32>>,
     /// Per triangle: an upper bound on the distance of its samples to the input, and their
@@ -269,7 +261,6 @@ impl<'a> Remesher<'a> {
             kept_ends: f.edges.iter().flat_map(|&(a, b)| [a, b]).collect(),
             input,
             samples,
-            cover_w: vec![[1.0; 3]; cover.len()],
             cover,
             covers,
             dev: vec![(f64::INFINITY, 0); s.triangles.len()],
@@ -444,17 +435,16 @@ impl<'a> Remesher<'a> {
     /// triangle and every triangle that stays. Samples covered by a triangle that stays stay
     /// covered, so this keeps every input sample within the tolerance of the surface.
     ///
-    /// `moved = Some((v, m))` says that `new[k]` is `old[k]` with its corner `v` moved by `m` (a
-    /// point move): a sample within `d` of the point of weights `w` of its old triangle is within
-    /// `d + w[v] m` of the new one, and where that is within the tolerance no distance is
-    /// computed.
+    /// `moved` > 0 says that `new[k]` is `old[k]` with one corner moved by that distance (a
+    /// point move): every point of the old triangle is within `moved` of the new one, so a
+    /// sample whose bound plus `moved` is within the tolerance needs no distance computed.
     fn recover_samples(
         &self,
         old: &[u32],
         new: &[([u32; 3], [P3; 3])],
         new_ids: &[u32],
-        moved: Option<(u32, f64)>,
-    ) -> Option<Vec<Cover>> {
+        moved: f64,
+    ) -> Option<Vec<(u32, u32, f64)>> {
         let tol = self.tol;
         let t2 = tol * tol;
         let lim = tol * (1.0 - 1e-9);
@@ -464,19 +454,11 @@ impl<'a> Remesher<'a> {
         // mostly share it).
         let mut last = 0;
         for &t in old {
-            let corner = moved.and_then(|(v, m)| {
-                let k = self.tris[t as usize].iter().position(|&x| x == v)?;
-                Some((k, m))
-            });
             for &s in &self.covers[t as usize] {
-                let (_, d) = self.cover[s as usize];
-                let w = self.cover_w[s as usize];
-                if let Some((k, m)) = corner {
-                    let b = d + w[k].abs() * m;
-                    if b <= lim {
-                        plan.push((s, t, b, w));
-                        continue;
-                    }
+                let d = self.cover[s as usize].1;
+                if moved > 0.0 && d + moved <= lim {
+                    plan.push((s, t, d + moved));
+                    continue;
                 }
                 let p = self.samples.pts[s as usize];
                 let sides = self.samples.sides[s as usize];
@@ -494,7 +476,7 @@ impl<'a> Remesher<'a> {
                 });
                 if let Some((k, d2)) = found {
                     last = k;
-                    plan.push((s, new_ids[k], d2.sqrt(), closest_weights(p, &new[k].1)));
+                    plan.push((s, new_ids[k], d2.sqrt()));
                     continue;
                 }
                 // The triangles that stay.
@@ -505,22 +487,21 @@ impl<'a> Remesher<'a> {
                         && !old.contains(&u)
                         && self.sides[u as usize] == sides
                     {
-                        let c = self.corners(u);
-                        within_d2(p, &c, tol, t2).map(|d2| (u, d2, closest_weights(p, &c)))
+                        within_d2(p, &self.corners(u), tol, t2).map(|d2| (u, d2))
                     } else {
                         None
                     }
                 });
-                let (u, d2, w) = kept?;
-                plan.push((s, u, d2.sqrt(), w));
+                let (u, d2) = kept?;
+                plan.push((s, u, d2.sqrt()));
             }
         }
         Some(plan)
     }
 
     /// Apply the covers of [`Self::recover_samples`].
-    fn apply_covers(&mut self, plan: &[Cover]) {
-        for &(s, t, d, w) in plan {
+    fn apply_covers(&mut self, plan: &[(u32, u32, f64)]) {
+        for &(s, t, d) in plan {
             let (was, _) = self.cover[s as usize];
             if was != t {
                 let l = &mut self.covers[was as usize];
@@ -530,7 +511,6 @@ impl<'a> Remesher<'a> {
                 self.covers[t as usize].push(s);
             }
             self.cover[s as usize] = (t, d);
-            self.cover_w[s as usize] = w;
         }
     }
 
@@ -729,7 +709,7 @@ impl<'a> Remesher<'a> {
         }
         let moved = dist2(x, self.pts[v as usize]).sqrt();
         let devs = self.new_near_input(&new, fan, Some((v, moved)))?;
-        let plan = self.recover_samples(fan, &new, fan, Some((v, moved)))?;
+        let plan = self.recover_samples(fan, &new, fan, moved)?;
         if self.crosses(&new, fan) {
             return None;
         }
@@ -830,9 +810,9 @@ impl<'a> Remesher<'a> {
                     dist2(p, closest_on_triangle(p, &ch)),
                 );
                 plan.push(if dh < dt {
-                    (s, h, dh.sqrt(), closest_weights(p, &ch))
+                    (s, h, dh.sqrt())
                 } else {
-                    (s, t, dt.sqrt(), closest_weights(p, &ct))
+                    (s, t, dt.sqrt())
                 });
             }
         }
@@ -964,7 +944,7 @@ impl<'a> Remesher<'a> {
         {
             return None;
         }
-        let plan = self.recover_samples(&fan, &new, &kept, None)?;
+        let plan = self.recover_samples(&fan, &new, &kept, 0.0)?;
         if self.crosses(&new, &fan) {
             return None;
         }
@@ -1070,7 +1050,7 @@ impl<'a> Remesher<'a> {
         let Some(devs) = self.new_near_input(&new, &[t1, t2], None) else {
             return Flip::Refused;
         };
-        let Some(plan) = self.recover_samples(&[t1, t2], &new, &[t1, t2], None) else {
+        let Some(plan) = self.recover_samples(&[t1, t2], &new, &[t1, t2], 0.0) else {
             return Flip::Refused;
         };
         if self.crosses(&new, &[t1, t2]) {
