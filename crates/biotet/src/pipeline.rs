@@ -432,7 +432,12 @@ fn tetrahedralize(
         let inside: Vec<bool> = labels.iter().map(|&l| l != 0).collect();
         retain_tets(&mut tets, &mut neighbors, &mut labels, &inside);
     }
-    let mut mesh = compact(points, tets, neighbors, labels);
+    let mut mesh = compact(TetMesh {
+        points,
+        tets,
+        neighbors,
+        labels,
+    });
     stage(report, "keep inside", clock);
 
     if let Some(o) = recover {
@@ -442,13 +447,7 @@ fn tetrahedralize(
         report.n_centroid_tests = r.centroid_tests;
         report.recover = Some(r);
         // Recovery drops the outside tets; drop the points only they used.
-        let TetMesh {
-            points,
-            tets,
-            neighbors,
-            labels,
-        } = mesh;
-        mesh = compact(points, tets, neighbors, labels);
+        mesh = compact(mesh);
         stage(report, "recover", clock);
     }
     Ok(mesh)
@@ -601,13 +600,7 @@ fn recover_star(
     r.steiner_points = star.regions;
     r.tets_after = mesh.tets.len();
     report.star = Some(star);
-    let TetMesh {
-        points,
-        tets,
-        neighbors,
-        labels,
-    } = mesh;
-    let mesh = compact(points, tets, neighbors, labels);
+    let mesh = compact(mesh);
     stage(report, "star", clock);
     Some(mesh)
 }
@@ -672,21 +665,10 @@ fn extent(points: &[[f64; 3]]) -> f64 {
     (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max)
 }
 
-/// Assemble the mesh, dropping points no tet uses (the others keep their order, surface points
+/// `mesh` without the points no tet uses (the others keep their order, surface points
 /// first). In place: after recovery this runs on top of that stage's peak.
-fn compact(
-    mut points: Vec<[f64; 3]>,
-    mut tets: Vec<[u32; 4]>,
-    neighbors: Vec<[u32; 4]>,
-    labels: Vec<u32>,
-) -> TetMesh {
-    crate::mesh::drop_unused_points(&mut points, tets.as_flattened_mut(), 0);
-    let mut mesh = TetMesh {
-        points,
-        tets,
-        neighbors,
-        labels,
-    };
+fn compact(mut mesh: TetMesh) -> TetMesh {
+    crate::mesh::drop_unused_points(&mut mesh.points, mesh.tets.as_flattened_mut(), 0);
     // Recovery truncates the arrays in place: give the slack back for the later stages.
     mesh.points.shrink_to_fit();
     mesh.tets.shrink_to_fit();

@@ -24,7 +24,7 @@ use crate::geom::predicates::{Sign, orient3d};
 use crate::geom::vec3::{norm2, sub};
 use crate::mesh::cavity;
 use crate::mesh::surface::SurfaceMesh;
-use crate::mesh::tet::{NO_NEIGHBOR, TetMesh, retain_tets};
+use crate::mesh::tet::{NO_NEIGHBOR, TetMesh};
 use crate::quality::tet::{circumcentre, min_dihedral_deg_by_chord};
 use crate::surface::bvh::Bvh;
 
@@ -61,19 +61,7 @@ pub fn insert_seeds(mesh: &mut TetMesh, ns: usize, surface: &SurfaceMesh) -> usi
     for (x, cavity) in seeds {
         cavity::cone_in(mesh, x, &cavity, &mut dead);
     }
-    if !dead.is_empty() {
-        let mut keep = vec![true; mesh.tets.len()];
-        for t in dead {
-            keep[t as usize] = false;
-        }
-        let TetMesh {
-            tets,
-            neighbors,
-            labels,
-            ..
-        } = mesh;
-        retain_tets(tets, neighbors, labels, &keep);
-    }
+    cavity::drop_dead(mesh, &dead);
     n
 }
 

@@ -24,7 +24,7 @@ use crate::geom::predicates::{Sign, orient3d};
 use crate::geom::vec3::{add, cross, dot, scale, sub};
 use crate::mesh::cavity;
 use crate::mesh::surface::SurfaceMesh;
-use crate::mesh::tet::{NO_NEIGHBOR, TetMesh, retain_tets};
+use crate::mesh::tet::{NO_NEIGHBOR, TetMesh};
 
 type P3 = [f64; 3];
 
@@ -187,19 +187,7 @@ pub fn coned(
         report.nodes_inserted += 1;
     }
     // Slots left over by cones with fewer tets than their cavities (a 1-4 split has more).
-    if !dead.is_empty() {
-        let mut keep = vec![true; mesh.tets.len()];
-        for t in dead {
-            keep[t as usize] = false;
-        }
-        let TetMesh {
-            tets,
-            neighbors,
-            labels,
-            ..
-        } = &mut mesh;
-        retain_tets(tets, neighbors, labels, &keep);
-    }
+    cavity::drop_dead(&mut mesh, &dead);
     (mesh, report)
 }
 

@@ -8,7 +8,7 @@ use crate::geom::predicates::{Sign, orient3d};
 use crate::geom::vec3::{norm2, sub};
 use crate::quality::tet::circumcentre;
 
-use super::tet::{NO_NEIGHBOR, TET_FACES, TetMesh};
+use super::tet::{NO_NEIGHBOR, TET_FACES, TetMesh, retain_tets};
 
 /// The shell of the tets `cavity` (`inside(t)`: `t` is one of them): each face with no cavity
 /// tet across, turned to point into the cavity, with the tet across it and that tet's local face
@@ -178,6 +178,24 @@ pub fn cone_in(mesh: &mut TetMesh, x: [f64; 3], cavity: &[u32], dead: &mut Vec<u
     }
     dead.extend(cavity.iter().skip(faces.len()));
     stitch(&mesh.tets, &mut mesh.neighbors, &ids, &faces, &outer);
+}
+
+/// Drop the tets `dead` (the slots [`cone_in`] left over), adjacency kept.
+pub fn drop_dead(mesh: &mut TetMesh, dead: &[u32]) {
+    if dead.is_empty() {
+        return;
+    }
+    let mut keep = vec![true; mesh.tets.len()];
+    for &t in dead {
+        keep[t as usize] = false;
+    }
+    let TetMesh {
+        tets,
+        neighbors,
+        labels,
+        ..
+    } = mesh;
+    retain_tets(tets, neighbors, labels, &keep);
 }
 
 #[cfg(test)]
