@@ -20,7 +20,6 @@
 
 use rayon::prelude::*;
 
-use crate::geom::predicates::{Sign, orient3d};
 use crate::geom::vec3::{norm2, sub};
 use crate::mesh::cavity;
 use crate::mesh::surface::SurfaceMesh;
@@ -201,32 +200,8 @@ fn cone_ok(mesh: &TetMesh, cavity: &[u32], x: P3) -> bool {
     new > old && cavity::cone_valid(mesh, cavity, &faces, x)
 }
 
-/// The tet of `t`'s region holding `x` strictly inside, walking from `t` through faces `x` lies
-/// strictly beyond (exact); `None` if the walk would leave the region, lands on a face or stalls.
+/// The tet of `t`'s region holding `x` strictly inside ([`cavity::walk`]); `None` if the walk
+/// would leave the region, lands on a face or stalls.
 fn locate(mesh: &TetMesh, t: u32, x: P3) -> Option<u32> {
-    let label = mesh.labels[t as usize];
-    let mut s = t;
-    'walk: for _ in 0..WALK_STEPS {
-        let v = mesh.tets[s as usize].map(|i| mesh.points[i as usize]);
-        let mut on_face = false;
-        for k in 0..4 {
-            // x in place of corner k: negative when x lies beyond the face opposite it.
-            let mut w = v;
-            w[k] = x;
-            match orient3d(w[0], w[1], w[2], w[3]) {
-                Sign::Negative => {
-                    let n = mesh.neighbors[s as usize][k];
-                    if n == NO_NEIGHBOR || mesh.labels[n as usize] != label {
-                        return None;
-                    }
-                    s = n;
-                    continue 'walk;
-                }
-                Sign::Zero => on_face = true,
-                Sign::Positive => {}
-            }
-        }
-        return (!on_face).then_some(s);
-    }
-    None
+    cavity::walk(mesh, t, x, WALK_STEPS).and_then(|(s, inside)| inside.then_some(s))
 }

@@ -24,7 +24,7 @@ use crate::geom::predicates::{Sign, orient3d};
 use crate::geom::vec3::{add, cross, dot, scale, sub};
 use crate::mesh::cavity;
 use crate::mesh::surface::SurfaceMesh;
-use crate::mesh::tet::{NO_NEIGHBOR, TetMesh};
+use crate::mesh::tet::TetMesh;
 
 type P3 = [f64; 3];
 
@@ -253,44 +253,18 @@ fn grid_keys(points: &[P3]) -> Vec<u64> {
 }
 
 /// The tet of region `label` holding `x`, and whether strictly inside (else on its boundary): a
-/// walk from `start` through faces `x` lies strictly beyond (exact), then, if it leaves the
-/// region or stalls, a scan of every tet of the region.
+/// walk from `start` ([`cavity::walk`]), then, if it leaves the region or stalls, a scan of every
+/// tet of the region.
 fn locate(mesh: &TetMesh, start: u32, x: P3, label: u32) -> Option<(u32, bool)> {
-    // Some(true): strictly inside; Some(false): on its boundary; None: beyond face `k` (given).
-    let holds = |s: u32| -> Result<bool, usize> {
-        let v = mesh.tets[s as usize].map(|i| mesh.points[i as usize]);
-        let mut on_face = false;
-        for k in 0..4 {
-            // x in place of corner k: negative when x lies beyond the face opposite it.
-            let mut w = v;
-            w[k] = x;
-            match orient3d(w[0], w[1], w[2], w[3]) {
-                Sign::Negative => return Err(k),
-                Sign::Zero => on_face = true,
-                Sign::Positive => {}
-            }
-        }
-        Ok(!on_face)
-    };
-    let mut s = start;
-    if (s as usize) < mesh.tets.len() && mesh.labels[s as usize] == label {
-        for _ in 0..WALK_STEPS {
-            match holds(s) {
-                Ok(inside) => return Some((s, inside)),
-                Err(k) => {
-                    let n = mesh.neighbors[s as usize][k];
-                    if n == NO_NEIGHBOR || mesh.labels[n as usize] != label {
-                        break;
-                    }
-                    s = n;
-                }
-            }
-        }
-    }
+    let walked = ((start as usize) < mesh.tets.len() && mesh.labels[start as usize] == label)
+        .then(|| cavity::walk(mesh, start, x, WALK_STEPS))
+        .flatten();
     // The scan: a region need not be convex, so the walk may leave it.
-    (0..mesh.tets.len() as u32)
-        .filter(|&t| mesh.labels[t as usize] == label)
-        .find_map(|t| holds(t).ok().map(|inside| (t, inside)))
+    walked.or_else(|| {
+        (0..mesh.tets.len() as u32)
+            .filter(|&t| mesh.labels[t as usize] == label)
+            .find_map(|t| cavity::where_in(mesh, t, x).ok().map(|inside| (t, inside)))
+    })
 }
 
 #[cfg(test)]

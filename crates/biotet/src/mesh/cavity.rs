@@ -180,6 +180,45 @@ pub fn cone_in(mesh: &mut TetMesh, x: [f64; 3], cavity: &[u32], dead: &mut Vec<u
     stitch(&mesh.tets, &mut mesh.neighbors, &ids, &faces, &outer);
 }
 
+/// Where `x` lies against tet `t`: `Ok(true)` strictly inside, `Ok(false)` on its boundary,
+/// `Err(k)` strictly beyond the face opposite corner `k` (exact).
+pub fn where_in(mesh: &TetMesh, t: u32, x: [f64; 3]) -> Result<bool, usize> {
+    let v = mesh.tets[t as usize].map(|i| mesh.points[i as usize]);
+    let mut on_face = false;
+    for k in 0..4 {
+        // x in place of corner k: negative when x lies beyond the face opposite it.
+        let mut w = v;
+        w[k] = x;
+        match orient3d(w[0], w[1], w[2], w[3]) {
+            Sign::Negative => return Err(k),
+            Sign::Zero => on_face = true,
+            Sign::Positive => {}
+        }
+    }
+    Ok(!on_face)
+}
+
+/// The tet of `start`'s region holding `x` and whether strictly inside ([`where_in`]), walking
+/// from `start` through faces `x` lies strictly beyond; `None` if the walk would leave the
+/// region or takes more than `steps`.
+pub fn walk(mesh: &TetMesh, start: u32, x: [f64; 3], steps: usize) -> Option<(u32, bool)> {
+    let label = mesh.labels[start as usize];
+    let mut s = start;
+    for _ in 0..steps {
+        match where_in(mesh, s, x) {
+            Ok(inside) => return Some((s, inside)),
+            Err(k) => {
+                let n = mesh.neighbors[s as usize][k];
+                if n == NO_NEIGHBOR || mesh.labels[n as usize] != label {
+                    return None;
+                }
+                s = n;
+            }
+        }
+    }
+    None
+}
+
 /// Drop the tets `dead` (the slots [`cone_in`] left over), adjacency kept.
 pub fn drop_dead(mesh: &mut TetMesh, dead: &[u32]) {
     if dead.is_empty() {
