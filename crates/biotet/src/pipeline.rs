@@ -63,8 +63,10 @@ impl Default for PipelineOptions {
             deploy: DeployOptions::default(),
             // Small cavities first, then an interior point, before large cavities: see
             // `RecoverOptions::first_cavity_tets`.
+            // One wide round: the fallbacks follow (`RecoverOptions::max_wide_rounds`).
             recover: Some(RecoverOptions {
                 first_cavity_tets: PIPELINE_FIRST_CAVITY_TETS,
+                max_wide_rounds: 1,
                 ..RecoverOptions::default()
             }),
             // No grown cavities: polish, which follows, fixes what they would (wm_20k: 2,502

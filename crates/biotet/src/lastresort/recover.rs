@@ -144,6 +144,11 @@ pub struct RecoverOptions {
     /// is left and tries again instead, which costs milliseconds where wide cavities of a
     /// triangle far larger than the spacing cost seconds.
     pub widen: bool,
+    /// Rounds with the wide bounds at most: each may cost seconds in cavities of hundreds of
+    /// tets. The pipeline, whose fallbacks follow, takes one (a lattice of crossing bars: a
+    /// second wide round spent 6.6 s on the two triangles the first left, which points just
+    /// behind them then recovered in 0.9 s); `recover` alone takes as many as make progress.
+    pub max_wide_rounds: usize,
 }
 
 /// The crossed-tets cavity is tried only up to this many tets (larger ones go straight to the
@@ -182,6 +187,7 @@ impl Default for RecoverOptions {
             remove_outside: true,
             first_quality: 0.05,
             widen: true,
+            max_wide_rounds: STEINER_ROUNDS,
         }
     }
 }
@@ -365,13 +371,15 @@ fn recover_checked(
     if opts.allow_interior_steiner {
         // A Steiner fill changes the cavities of the triangles around it: alternate the
         // fallback with the no-new-point queue while either makes progress.
+        let mut wide_rounds = 0;
         for _ in 0..STEINER_ROUNDS {
             let before = r.count_missing();
             r.run_steiner();
             r.tries.clear();
             r.run();
             let after = r.count_missing();
-            if after == 0 {
+            wide_rounds += r.wide as usize;
+            if after == 0 || wide_rounds >= opts.max_wide_rounds {
                 break;
             }
             if after < before {
