@@ -586,7 +586,7 @@ fn recover_inset(
 /// points); `report.star` says how many triangles recovery had left.
 fn recover_star(
     surface: &SurfaceMesh,
-    kernels: &[Option<[f64; 3]>],
+    kernels: &[(u32, [f64; 3])],
     nodes: &Nodes,
     report: &mut MeshReport,
     progress: &mut dyn FnMut(&str),

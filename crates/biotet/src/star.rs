@@ -47,27 +47,22 @@ pub struct StarReport {
     pub triangles_left_by_recovery: usize,
 }
 
-/// The boundary triangles of each region of `surface` (labels 1 and up), each turned so its
-/// region is on the side of its normal: `[a, b, c]` with `orient3d(a, b, c, x) > 0` for `x` in
-/// the region just beyond it. Index `l - 1` for label `l`.
-fn region_faces(surface: &SurfaceMesh) -> Vec<Vec<[u32; 3]>> {
-    let n = surface
-        .sides
-        .iter()
-        .flat_map(|s| s.iter().copied())
-        .max()
-        .unwrap_or(0) as usize;
-    let mut out = vec![Vec::new(); n];
+/// The regions of `surface` (labels other than 0, in increasing order), each with its boundary
+/// triangles turned so the region is on the side of their normal: `[a, b, c]` with
+/// `orient3d(a, b, c, x) > 0` for `x` in the region just beyond it. (Keyed by label, not indexed
+/// by it: a label image's labels may be large.)
+fn region_faces(surface: &SurfaceMesh) -> Vec<(u32, Vec<[u32; 3]>)> {
+    let mut out: std::collections::BTreeMap<u32, Vec<[u32; 3]>> = Default::default();
     for (t, &[back, front]) in surface.triangles.iter().zip(&surface.sides) {
         // The normal (b - a) x (c - a) points to the front.
         if front != 0 {
-            out[front as usize - 1].push(*t);
+            out.entry(front).or_default().push(*t);
         }
         if back != 0 {
-            out[back as usize - 1].push([t[0], t[2], t[1]]);
+            out.entry(back).or_default().push([t[0], t[2], t[1]]);
         }
     }
-    out
+    out.into_iter().collect()
 }
 
 /// A point strictly inside the kernel of the region bounded by `faces` (turned as
@@ -106,23 +101,20 @@ fn kernel_point(points: &[P3], faces: &[[u32; 3]]) -> Option<P3> {
     })
 }
 
-/// A kernel point per region of `surface` (index `l - 1` for label `l`; `None` for a label
-/// with no triangle), if every region has one among the candidates and a connected boundary
-/// (two shells of one label have no single cone). Linear in the triangles: cheap enough to ask
-/// before recovery.
-pub fn kernels(surface: &SurfaceMesh) -> Option<Vec<Option<P3>>> {
-    region_faces(surface)
+/// A kernel point per region of `surface` (label and point, labels in increasing order), if
+/// every region has one among the candidates and a connected boundary (two shells of one label
+/// have no single cone). Linear in the triangles: cheap enough to ask before recovery.
+pub fn kernels(surface: &SurfaceMesh) -> Option<Vec<(u32, P3)>> {
+    let k: Vec<(u32, P3)> = region_faces(surface)
         .iter()
-        .map(|f| {
-            if f.is_empty() {
-                Some(None)
-            } else if connected(f) {
-                kernel_point(&surface.points, f).map(Some)
-            } else {
-                None
-            }
+        .map(|(label, f)| {
+            connected(f)
+                .then(|| kernel_point(&surface.points, f))
+                .flatten()
+                .map(|k| (*label, k))
         })
-        .collect()
+        .collect::<Option<_>>()?;
+    (!k.is_empty()).then_some(k)
 }
 
 /// Every region of `surface` coned from its kernel point ([`kernels`]), then the interior nodes
@@ -130,7 +122,7 @@ pub fn kernels(surface: &SurfaceMesh) -> Option<Vec<Option<P3>>> {
 /// the surface's points.
 pub fn coned(
     surface: &SurfaceMesh,
-    kernels: &[Option<P3>],
+    kernels: &[(u32, P3)],
     points: &[P3],
     regions: &[u32],
     ns: usize,
@@ -143,13 +135,12 @@ pub fn coned(
         labels: Vec::new(),
     };
     let mut report = StarReport::default();
-    for (i, (f, k)) in faces.iter().zip(kernels).enumerate() {
-        let Some(k) = *k else { continue };
+    for ((label, f), &(_, k)) in faces.iter().zip(kernels) {
         let apex = mesh.points.len() as u32;
         mesh.points.push(k);
         for t in f {
             mesh.tets.push([t[0], t[1], t[2], apex]);
-            mesh.labels.push(i as u32 + 1);
+            mesh.labels.push(*label);
         }
         report.regions += 1;
     }
@@ -276,7 +267,9 @@ mod tests {
     /// in, and the mesh valid against the surface.
     #[test]
     fn a_sphere_cones_from_its_centre_with_its_nodes() {
-        let s = SurfaceMesh::icosphere(1.0, 2);
+        let mut s = SurfaceMesh::icosphere(1.0, 2);
+        // A label image's label: regions are keyed by label, not indexed by it.
+        s.sides.iter_mut().for_each(|x| *x = [70_000, 0]);
         let ns = s.points.len();
         let mut points = s.points.clone();
         let mut regions = Vec::new();
@@ -287,10 +280,11 @@ mod tests {
                 0.5 * a.sin(),
                 0.4 * (0.5 * a).cos(),
             ]);
-            regions.push(1);
+            regions.push(70_000);
         }
         let k = kernels(&s).expect("a sphere is star-shaped");
         let (mesh, report) = coned(&s, &k, &points, &regions, ns);
+        assert!(mesh.labels.iter().all(|&l| l == 70_000));
         assert_eq!(report.regions, 1);
         assert_eq!(report.nodes_inserted + report.nodes_left_out, 20);
         assert_eq!(report.nodes_left_out, 0);
@@ -337,5 +331,81 @@ mod tests {
             .extend(s.triangles.iter().map(|f| f.map(|v| v + k)));
         two.sides.extend(s.sides.iter().copied());
         assert!(kernels(&two).is_none());
+    }
+
+    /// Two boxes sharing a face, two regions: each coned from its own centre, the shared face a
+    /// face of both cones, the mesh valid with both labels.
+    #[test]
+    fn two_boxes_sharing_a_face_cone_each_from_its_own_centre() {
+        let mut s = SurfaceMesh::default();
+        let id = |x: usize, y: usize, z: usize| (x * 4 + y * 2 + z) as u32;
+        for x in 0..3 {
+            for y in 0..2 {
+                for z in 0..2 {
+                    s.points.push([x as f64, y as f64, z as f64]);
+                }
+            }
+        }
+        // A quad split in two, turned so its normal is `n`, with sides [back, front].
+        let mut quad = |q: [u32; 4], n: [f64; 3], sides: [u32; 2]| {
+            for t in [[q[0], q[1], q[2]], [q[0], q[2], q[3]]] {
+                let c = t.map(|v| s.points[v as usize]);
+                let m = cross(sub(c[1], c[0]), sub(c[2], c[0]));
+                s.triangles.push(if dot(m, n) > 0.0 {
+                    t
+                } else {
+                    [t[0], t[2], t[1]]
+                });
+                s.sides.push(sides);
+            }
+        };
+        for (r, x0) in [(1u32, 0usize), (2, 1)] {
+            let x1 = x0 + 1;
+            quad(
+                [id(x0, 0, 0), id(x1, 0, 0), id(x1, 0, 1), id(x0, 0, 1)],
+                [0.0, -1.0, 0.0],
+                [r, 0],
+            );
+            quad(
+                [id(x0, 1, 0), id(x1, 1, 0), id(x1, 1, 1), id(x0, 1, 1)],
+                [0.0, 1.0, 0.0],
+                [r, 0],
+            );
+            quad(
+                [id(x0, 0, 0), id(x1, 0, 0), id(x1, 1, 0), id(x0, 1, 0)],
+                [0.0, 0.0, -1.0],
+                [r, 0],
+            );
+            quad(
+                [id(x0, 0, 1), id(x1, 0, 1), id(x1, 1, 1), id(x0, 1, 1)],
+                [0.0, 0.0, 1.0],
+                [r, 0],
+            );
+        }
+        quad(
+            [id(0, 0, 0), id(0, 1, 0), id(0, 1, 1), id(0, 0, 1)],
+            [-1.0, 0.0, 0.0],
+            [1, 0],
+        );
+        quad(
+            [id(2, 0, 0), id(2, 1, 0), id(2, 1, 1), id(2, 0, 1)],
+            [1.0, 0.0, 0.0],
+            [2, 0],
+        );
+        quad(
+            [id(1, 0, 0), id(1, 1, 0), id(1, 1, 1), id(1, 0, 1)],
+            [1.0, 0.0, 0.0],
+            [1, 2],
+        );
+        let k = kernels(&s).expect("boxes are star-shaped");
+        assert_eq!(k, vec![(1, [0.5, 0.5, 0.5]), (2, [1.5, 0.5, 0.5])]);
+        let ns = s.points.len();
+        let (mesh, report) = coned(&s, &k, &s.points, &[], ns);
+        assert_eq!(report.regions, 2);
+        assert_eq!(mesh.tets.len(), 24);
+        assert_eq!(crate::pipeline::missing_triangles(&mesh, &s), 0);
+        let c = check(&mesh, Some(&s));
+        assert!(c.valid, "{c:?}");
+        assert_eq!(mesh.labels.iter().filter(|&&l| l == 2).count(), 12);
     }
 }
