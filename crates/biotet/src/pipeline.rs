@@ -131,8 +131,8 @@ pub struct MeshReport {
     pub recover: Option<RecoverReport>,
     /// Retries of recovery without the interior nodes near the triangles it left, in order.
     pub retries: Vec<RetryReport>,
-    /// Where recovery and its retries left triangles and every region is star-shaped: the
-    /// regions coned from interior points instead ([`crate::star`]).
+    /// Where recovery left triangles and every region is star-shaped: the regions coned from
+    /// interior points instead ([`crate::star`]).
     pub star: Option<crate::star::StarReport>,
     /// Interior seeds added in thin sections after recovery ([`crate::seeds`]).
     pub seeds: usize,
