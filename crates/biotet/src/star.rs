@@ -173,7 +173,13 @@ pub fn coned(
             report.nodes_left_out += 1;
             continue;
         };
+        let before = dead.len();
         cavity::cone_in(&mut mesh, x, &cav, &mut dead);
+        // Slots left over keep their old corners until dropped: out of every region, so the
+        // scan of `locate` cannot land in one.
+        for &t in &dead[before..] {
+            mesh.labels[t as usize] = u32::MAX;
+        }
         last = cav[0];
         report.nodes_inserted += 1;
     }
