@@ -532,7 +532,11 @@ pub fn run(a: Args) -> Result<ExitCode> {
                 s.regions,
                 s.nodes_inserted,
                 if s.nodes_left_out > 0 {
-                    format!(" ({} left out, on a face)", s.nodes_left_out)
+                    format!(
+                        " ({} left out, no valid cavity among the cone's thin tets: the mesh is \
+                         coarser there than asked)",
+                        s.nodes_left_out
+                    )
                 } else {
                     String::new()
                 }
