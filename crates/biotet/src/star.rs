@@ -196,7 +196,7 @@ pub fn coned(
         }
     }
     report.nodes_left_out = order.len();
-    // Slots left over by cones with fewer tets than their cavities (a 1-4 split has more).
+    // Slots left over by cones with fewer tets than their cavities.
     cavity::drop_dead(&mut mesh, &dead);
     (mesh, report)
 }
