@@ -378,28 +378,16 @@ mod tests {
                 s.sides.push(sides);
             }
         };
+        // The sides y = 0, y = 1, z = 0, z = 1 of each box, in that order.
         for (r, x0) in [(1u32, 0usize), (2, 1)] {
             let x1 = x0 + 1;
-            quad(
-                [id(x0, 0, 0), id(x1, 0, 0), id(x1, 0, 1), id(x0, 0, 1)],
-                [0.0, -1.0, 0.0],
-                [r, 0],
-            );
-            quad(
-                [id(x0, 1, 0), id(x1, 1, 0), id(x1, 1, 1), id(x0, 1, 1)],
-                [0.0, 1.0, 0.0],
-                [r, 0],
-            );
-            quad(
-                [id(x0, 0, 0), id(x1, 0, 0), id(x1, 1, 0), id(x0, 1, 0)],
-                [0.0, 0.0, -1.0],
-                [r, 0],
-            );
-            quad(
-                [id(x0, 0, 1), id(x1, 0, 1), id(x1, 1, 1), id(x0, 1, 1)],
-                [0.0, 0.0, 1.0],
-                [r, 0],
-            );
+            for (axis, w) in [(1, 0), (1, 1), (2, 0), (2, 1)] {
+                // Corner (x, u) of the face: u runs along the other of y and z.
+                let at = |x: usize, u: usize| if axis == 1 { id(x, w, u) } else { id(x, u, w) };
+                let mut n = [0.0; 3];
+                n[axis] = if w == 0 { -1.0 } else { 1.0 };
+                quad([at(x0, 0), at(x1, 0), at(x1, 1), at(x0, 1)], n, [r, 0]);
+            }
         }
         quad(
             [id(0, 0, 0), id(0, 1, 0), id(0, 1, 1), id(0, 0, 1)],
