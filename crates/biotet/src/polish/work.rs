@@ -2,6 +2,7 @@
 //! points are fixed (on a boundary or interface face) and which tets the input forces poor.
 
 use crate::mesh::tet::{NO_NEIGHBOR, TET_EDGES, TET_FACES, TetMesh};
+use crate::quality::forced::face_forces;
 use crate::quality::tet::{dihedral_at, dihedral_yx};
 use crate::quality::tri::min_angle_3d_deg;
 
@@ -236,9 +237,11 @@ impl Work {
         let lim = self.forced_deg;
         for (i, l) in TET_FACES.iter().enumerate() {
             let n = self.nb[t as usize][i];
-            if self.outside(label, n)
-                && min_angle_3d_deg(&l.map(|k| self.pts[tv[k] as usize])) < lim
-            {
+            if !self.outside(label, n) {
+                continue;
+            }
+            let a = min_angle_3d_deg(&l.map(|k| self.pts[tv[k] as usize]));
+            if a < lim && face_forces(a, self.min_angle(t), lim) {
                 return true;
             }
         }

@@ -4,7 +4,8 @@
 //! meet at a tiny interior angle. Any mesh that keeps the surface must then contain a tet with a
 //! tiny solid (and usually dihedral) angle there, whatever the fill: such a tet is *forced*. A tet
 //! is forced when
-//! - one of its faces is an input triangle whose smallest angle is below the threshold, or
+//! - one of its faces is an input triangle whose smallest angle is below the threshold (unless
+//!   the tet is far flatter than that triangle: see [`face_forces`]), or
 //! - one of its edges is an input edge at which the surface, seen from the tet's region, folds
 //!   to an interior dihedral angle below the threshold.
 //!
@@ -19,6 +20,19 @@ use crate::mesh::surface::SurfaceMesh;
 use crate::mesh::tet::{TET_EDGES, TET_FACES, TetMesh};
 use crate::quality::tet::{TetMeasures, dihedral_angles};
 use crate::quality::tri::min_angle_3d_deg;
+
+/// A tet whose smallest dihedral angle is below this fraction of its poor input face's smallest
+/// angle is flatter than the face forces: a tet on a needle of angle α can have its angles near
+/// α (its edge from the needle's tip square to the needle), and a flat one on a planar quad of a
+/// needle and its neighbour (a lattice's joint kept one at 3e-15° on a 2.75° needle, TetGen
+/// 0.09° there) is the mesher's to fix.
+pub const FLAT_BELOW_FACE: f64 = 1e-3;
+
+/// Whether an input face whose smallest angle is `face_deg` forces a tet on it whose smallest
+/// dihedral angle is `tet_deg` (degrees) to be poor against `threshold_deg`.
+pub fn face_forces(face_deg: f64, tet_deg: f64, threshold_deg: f64) -> bool {
+    face_deg < threshold_deg && tet_deg >= FLAT_BELOW_FACE * face_deg
+}
 
 /// Where a tet touches the input surface.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -120,9 +134,10 @@ pub fn classify(mesh: &TetMesh, surface: &SurfaceMesh, threshold_deg: f64) -> Fo
     let tri_key = |t: u32| sorted3(surface.triangles[t as usize]);
     let mut triangles: Vec<u32> = (0..surface.triangles.len() as u32).collect();
     triangles.sort_unstable_by(|&a, &b| tri_key(a).cmp(&tri_key(b)).then(a.cmp(&b)));
-    let poor: Vec<bool> = (0..surface.triangles.len())
-        .map(|t| min_angle_3d_deg(&surface.corners(t)) < threshold_deg)
+    let face_deg: Vec<f64> = (0..surface.triangles.len())
+        .map(|t| min_angle_3d_deg(&surface.corners(t)))
         .collect();
+    let poor: Vec<bool> = face_deg.iter().map(|&a| a < threshold_deg).collect();
     // Half-edge 3t+k runs from corner k of triangle t to corner k+1; its use of the edge is
     // (triangle t, opposite corner k+2).
     let edge_key = |h: u32| {
@@ -145,6 +160,7 @@ pub fn classify(mesh: &TetMesh, surface: &SurfaceMesh, threshold_deg: f64) -> Fo
             Placement::Interior
         };
         let mut is_forced = false;
+        let mut tet_deg = None;
         if n_surf >= 3 {
             for f in TET_FACES {
                 let k = [s[f[0]], s[f[1]], s[f[2]]];
@@ -156,7 +172,14 @@ pub fn classify(mesh: &TetMesh, surface: &SurfaceMesh, threshold_deg: f64) -> Fo
                 let n = triangles.partition_point(|&i| tri_key(i) <= k);
                 if n > 0 && tri_key(triangles[n - 1]) == k {
                     place = Placement::Face;
-                    is_forced |= poor[triangles[n - 1] as usize];
+                    let f = triangles[n - 1] as usize;
+                    if poor[f] && !is_forced {
+                        let d = *tet_deg.get_or_insert_with(|| {
+                            let a = dihedral_angles(&mesh.corners(t));
+                            a.iter().fold(f64::INFINITY, |m, &x| m.min(x)).to_degrees()
+                        });
+                        is_forced = face_forces(face_deg[f], d, threshold_deg);
+                    }
                 }
             }
         }

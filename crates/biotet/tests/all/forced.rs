@@ -3,7 +3,7 @@
 use crate::common::{cube_surface, cube6, load_stl, tetgen_brain};
 use biotet::SurfaceMesh;
 use biotet::TetMesh;
-use biotet::quality::forced::{Placement, classify, placement_quality, summarise};
+use biotet::quality::forced::{Placement, classify, face_forces, placement_quality, summarise};
 
 #[test]
 fn a_good_cube_has_no_forced_tets() {
@@ -39,6 +39,53 @@ fn a_needle_triangle_and_a_sharp_fold_force_their_tets() {
     // angles at the tet's edges (its own dihedral angles) are all above 2°.
     let f = classify(&m, &s, 2.0);
     assert_eq!(f.forced, vec![false]);
+}
+
+/// A needle forces its tet below the threshold, not flat: on a cube whose bottom holds a 2.3°
+/// needle, a tet on the needle is forced, the same tet squashed to 1e-9 of its height (angles
+/// near 1e-7°) is not.
+#[test]
+fn a_tet_far_flatter_than_its_needle_is_not_forced() {
+    let mut p = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.5, 0.02, 0.0],
+        [0.0, 1.0, 0.0],
+        [1.0, 1.0, 0.0],
+    ];
+    p.extend([
+        [0.0, 0.0, 1.0],
+        [1.0, 0.0, 1.0],
+        [0.0, 1.0, 1.0],
+        [1.0, 1.0, 1.0],
+    ]);
+    // Bottom (needle 0-1-2 and its fan), top, then the four sides; outward.
+    let faces: Vec<[u32; 3]> = vec![
+        [0, 2, 1],
+        [0, 3, 2],
+        [2, 4, 1],
+        [2, 3, 4],
+        [5, 6, 8],
+        [5, 8, 7],
+        [0, 1, 6],
+        [0, 6, 5],
+        [1, 4, 8],
+        [1, 8, 6],
+        [4, 3, 7],
+        [4, 7, 8],
+        [3, 0, 5],
+        [3, 5, 7],
+    ];
+    let s = SurfaceMesh::closed(p.clone(), faces, 1);
+    for (h, forced) in [(0.5, true), (1e-9, false)] {
+        let mut q = p.clone();
+        q.push([0.5, 0.01, h]);
+        let mut tets = vec![[0u32, 1, 2, 9]];
+        crate::common::orient_all(&q, &mut tets);
+        let m = TetMesh::new(q, tets, vec![1]);
+        assert_eq!(classify(&m, &s, 10.0).forced, vec![forced], "height {h}");
+    }
+    assert!(face_forces(2.9, 0.01, 10.0) && !face_forces(2.9, 0.001, 10.0));
 }
 
 #[test]
