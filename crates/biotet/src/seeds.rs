@@ -15,15 +15,26 @@
 //! the cavity's worst. Cavities of two seeds never share a tet; every accepted cone replaces its
 //! cavity at once. Boundary and interface faces are never crossed, so they stay faces.
 //!
+//! Recovery can leave tets that span two or three segments of a tube (a twisted prism's six
+//! corners are cospherical, so the Delaunay there is a tie), whose circumcentres lie outside it or
+//! too near its walls: those segments get no seed. A second pass flips the poor tets the first
+//! left towards Delaunay (Lawson 2-3 and 3-2 flips of faces between two tets of surface points,
+//! one of them poor, exact `insphere`), on a copy; the groups of flips that a seed's cavity there
+//! takes are made on the mesh, and the poor tets they made give seeds as above. The other flips
+//! are dropped: they only trade one poor tet for another.
+//!
 //! The choice of points is floating point, as node placement is; every tet made is checked
 //! positive exactly. Sequential, in tet order: the same mesh on any number of threads.
 
 use rayon::prelude::*;
+use rustc_hash::FxHashSet;
 
+use crate::geom::predicates::{Sign, insphere, orient3d};
 use crate::geom::vec3::{norm2, sub};
 use crate::mesh::cavity;
+use crate::mesh::dsu::Dsu;
 use crate::mesh::surface::SurfaceMesh;
-use crate::mesh::tet::{NO_NEIGHBOR, TetMesh};
+use crate::mesh::tet::{NO_NEIGHBOR, TET_FACES, TetMesh};
 use crate::quality::tet::{circumcentre, min_dihedral_deg_by_chord};
 use crate::surface::bvh::Bvh;
 
@@ -53,7 +64,22 @@ const MAX_CAVITY: usize = 64;
 /// Insert the seeds into `mesh`, whose first `ns` points are the surface's (`surface` its
 /// boundary); returns how many. Adjacency is kept.
 pub fn insert_seeds(mesh: &mut TetMesh, ns: usize, surface: &SurfaceMesh) -> usize {
-    let seeds = choose(mesh, ns, surface);
+    let bad = poor_surface_tets(mesh, ns);
+    if bad.is_empty() {
+        return 0;
+    }
+    let bvh = Bvh::of_surface(surface);
+    let mut n = seed_pass(mesh, ns, &bvh, bad);
+    let left = poor_surface_tets(mesh, ns);
+    if !left.is_empty() {
+        n += flip_and_seed(mesh, ns, &bvh, &left);
+    }
+    n
+}
+
+/// The seeds [`choose`] takes from the poor tets `bad`, each cavity coned to its seed; how many.
+fn seed_pass(mesh: &mut TetMesh, ns: usize, bvh: &Bvh, bad: Vec<u32>) -> usize {
+    let seeds = choose(mesh, ns, bvh, bad);
     let n = seeds.len();
     // A cone may have fewer tets than its cavity: the slots left over go at the end.
     let mut dead: Vec<u32> = Vec::new();
@@ -67,19 +93,20 @@ pub fn insert_seeds(mesh: &mut TetMesh, ns: usize, surface: &SurfaceMesh) -> usi
 /// A seed: its point and its cavity's tets (sorted).
 type Seed = (P3, Vec<u32>);
 
-/// The seeds of the module docs, in the order of the tets that gave them: each poor tet not in
-/// an earlier seed's cavity tries its candidates in turn, the first that passes its seed.
-fn choose(mesh: &TetMesh, ns: usize, surface: &SurfaceMesh) -> Vec<Seed> {
+/// The tets of surface points below [`SEED_BELOW_DEG`], in order.
+fn poor_surface_tets(mesh: &TetMesh, ns: usize) -> Vec<u32> {
     let on_surface = |t: u32| mesh.tets[t as usize].iter().all(|&x| (x as usize) < ns);
     let corners = |t: u32| mesh.tets[t as usize].map(|x| mesh.points[x as usize]);
-    let bad: Vec<u32> = (0..mesh.tets.len() as u32)
+    (0..mesh.tets.len() as u32)
         .into_par_iter()
         .filter(|&t| on_surface(t) && min_dihedral_deg_by_chord(&corners(t)) < SEED_BELOW_DEG)
-        .collect();
-    if bad.is_empty() {
-        return Vec::new();
-    }
-    let bvh = Bvh::of_surface(surface);
+        .collect()
+}
+
+/// The seeds of the module docs, in the order of the poor tets `bad` that gave them: each not in
+/// an earlier seed's cavity tries its candidates in turn, the first that passes its seed.
+fn choose(mesh: &TetMesh, ns: usize, bvh: &Bvh, bad: Vec<u32>) -> Vec<Seed> {
+    let on_surface = |t: u32| mesh.tets[t as usize].iter().all(|&x| (x as usize) < ns);
     let mut claimed = vec![false; mesh.tets.len()];
     let mut seeds: Vec<Seed> = Vec::new();
     for t in bad {
@@ -95,7 +122,7 @@ fn choose(mesh: &TetMesh, ns: usize, surface: &SurfaceMesh) -> Vec<Seed> {
         );
         if let Some(seed) = tries
             .into_iter()
-            .find_map(|u| candidate(mesh, &bvh, u, &claimed))
+            .find_map(|u| candidate(mesh, bvh, u, &claimed))
         {
             for &x in &seed.1 {
                 claimed[x as usize] = true;
@@ -204,4 +231,210 @@ fn cone_ok(mesh: &TetMesh, cavity: &[u32], x: P3) -> bool {
 /// would leave the region, lands on a face or stalls.
 fn locate(mesh: &TetMesh, t: u32, x: P3) -> Option<u32> {
     cavity::walk(mesh, t, x, WALK_STEPS).and_then(|(s, inside)| inside.then_some(s))
+}
+
+/// A second pass over the poor tets `left` by the first, after the flips of
+/// [`flip_towards_delaunay`] from them that give a seed its cavity; how many seeds.
+///
+/// Recovery can leave tets that span several segments of a tube (a twisted prism's, whose six
+/// corners are cospherical), with circumcentres outside it or too large for the clearance: the
+/// segments between get no seed. The flips are tried on a copy, and only the groups of flips
+/// (sharing tets) that a seed's cavity there takes are made on `mesh`: elsewhere a flip trades
+/// one poor tet for another, and the stages after fared worse with them.
+fn flip_and_seed(mesh: &mut TetMesh, ns: usize, bvh: &Bvh, left: &[u32]) -> usize {
+    let mut trial = mesh.clone();
+    let (flips, alive) = flip_towards_delaunay(&mut trial, ns, left);
+    if flips.is_empty() {
+        return 0;
+    }
+    // Flips sharing a tet form a group; the group's last flip in a slot owns it.
+    let mut groups = Dsu::new(flips.len());
+    let mut owner = vec![u32::MAX; trial.tets.len()];
+    for (f, flip) in flips.iter().enumerate() {
+        for &s in &flip.old {
+            if owner[s as usize] != u32::MAX {
+                groups.union(f as u32, owner[s as usize]);
+            }
+        }
+        for &s in &flip.ids {
+            owner[s as usize] = f as u32;
+        }
+    }
+    // Only the poor tets the flips made: the others had their chance in the first pass.
+    let bad = poor_surface_tets(&trial, ns)
+        .into_iter()
+        .filter(|&t| alive[t as usize] && owner[t as usize] != u32::MAX)
+        .collect();
+    let seeds = choose(&trial, ns, bvh, bad);
+    let mut used = vec![false; flips.len()];
+    for &t in seeds.iter().flat_map(|s| &s.1) {
+        if owner[t as usize] != u32::MAX {
+            used[groups.find(owner[t as usize]) as usize] = true;
+        }
+    }
+    // The used groups' flips again, in order, on `mesh` (its slots mapped from the copy's).
+    let mut slot: Vec<u32> = (0..trial.tets.len() as u32).collect();
+    let mut dead = Vec::new();
+    let mut made = FxHashSet::default();
+    for (f, flip) in flips.iter().enumerate() {
+        if !used[groups.find(f as u32) as usize] {
+            continue;
+        }
+        made.extend(flip.made.iter().map(|&t| sorted(t)));
+        let old = flip.old.iter().map(|&s| slot[s as usize]).collect();
+        let (old, ids) = replace(mesh, old, &flip.made);
+        for (&t, &r) in flip.ids.iter().zip(&ids) {
+            slot[t as usize] = r;
+        }
+        dead.extend(old.into_iter().filter(|s| !ids.contains(s)));
+    }
+    if made.is_empty() {
+        return 0;
+    }
+    cavity::drop_dead(mesh, &dead);
+    let bad = poor_surface_tets(mesh, ns)
+        .into_iter()
+        .filter(|&t| made.contains(&sorted(mesh.tets[t as usize])))
+        .collect();
+    seed_pass(mesh, ns, bvh, bad)
+}
+
+fn sorted(mut t: [u32; 4]) -> [u32; 4] {
+    t.sort_unstable();
+    t
+}
+
+/// A flip: the slots of its old tets (sorted), its new tets and their slots.
+struct Flip {
+    old: Vec<u32>,
+    made: Vec<[u32; 4]>,
+    ids: Vec<u32>,
+}
+
+/// Lawson flips (2-3 and 3-2, exact `insphere`/`orient3d`) of the faces between two tets of
+/// surface points of one label, one of them below [`SEED_BELOW_DEG`], whose circumsphere
+/// strictly holds the other's far corner; from the tets `start`, then the new ones (sequential).
+/// The flips in order, and which slots hold a tet (the others are left for [`cavity::drop_dead`]).
+/// Adjacency is kept.
+fn flip_towards_delaunay(mesh: &mut TetMesh, ns: usize, start: &[u32]) -> (Vec<Flip>, Vec<bool>) {
+    let mut alive = vec![true; mesh.tets.len()];
+    let mut stack: Vec<u32> = start.iter().rev().copied().collect();
+    let mut flips = Vec::new();
+    while let Some(t) = stack.pop() {
+        if !alive[t as usize] {
+            continue;
+        }
+        if let Some(flip) = (0..4).find_map(|i| flip_face(mesh, ns, t, i)) {
+            alive.resize(mesh.tets.len(), true);
+            for &s in &flip.old {
+                if !flip.ids.contains(&s) {
+                    alive[s as usize] = false;
+                }
+            }
+            stack.extend(flip.ids.iter().rev());
+            flips.push(flip);
+        }
+    }
+    (flips, alive)
+}
+
+/// Flip the face of `t` opposite its corner `i` when the rule of [`flip_towards_delaunay`] asks
+/// for it and a 2-3 or 3-2 flip is valid.
+fn flip_face(mesh: &mut TetMesh, ns: usize, t: u32, i: usize) -> Option<Flip> {
+    let n = mesh.neighbors[t as usize][i];
+    if n == NO_NEIGHBOR || mesh.labels[n as usize] != mesh.labels[t as usize] {
+        return None;
+    }
+    let tv = mesh.tets[t as usize];
+    let nv = mesh.tets[n as usize];
+    let surface_only = |v: &[u32; 4]| v.iter().all(|&x| (x as usize) < ns);
+    if !surface_only(&tv) || !surface_only(&nv) {
+        return None;
+    }
+    let p = |v: u32| mesh.points[v as usize];
+    let poor = |v: &[u32; 4]| min_dihedral_deg_by_chord(&v.map(p)) < SEED_BELOW_DEG;
+    if !poor(&tv) && !poor(&nv) {
+        return None;
+    }
+    let d = tv[i];
+    let e = *nv.iter().find(|v| !tv.contains(v))?;
+    if insphere(p(tv[0]), p(tv[1]), p(tv[2]), p(tv[3]), p(e)) != Sign::Positive {
+        return None;
+    }
+    let f = TET_FACES[i].map(|k| tv[k]);
+    // 2-3: the edge de crosses the face inside, the three tets around it all positive.
+    let ring = [[f[0], f[1]], [f[1], f[2]], [f[2], f[0]]];
+    let signs = ring.map(|[x, y]| orient3d(p(d), p(e), p(x), p(y)));
+    if signs.iter().all(|&s| s == signs[0]) && signs[0] != Sign::Zero {
+        let made: Vec<[u32; 4]> = ring
+            .iter()
+            .map(|&[x, y]| {
+                if signs[0] == Sign::Positive {
+                    [d, e, x, y]
+                } else {
+                    [d, e, y, x]
+                }
+            })
+            .collect();
+        let (old, ids) = replace(mesh, vec![t, n], &made);
+        return Some(Flip { old, made, ids });
+    }
+    // 3-2: an edge xy of the face has just these two tets and one more, {x, y, d, e}, around it
+    // and crosses the triangle dez inside.
+    for k in 0..3 {
+        let (x, y, z) = (f[k], f[(k + 1) % 3], f[(k + 2) % 3]);
+        let across = |s: u32, sv: [u32; 4]| {
+            let j = sv.iter().position(|&v| v == z).unwrap();
+            mesh.neighbors[s as usize][j]
+        };
+        let m = across(t, tv);
+        if m == NO_NEIGHBOR
+            || m != across(n, nv)
+            || mesh.labels[m as usize] != mesh.labels[t as usize]
+        {
+            continue;
+        }
+        let sx = orient3d(p(d), p(e), p(z), p(x));
+        let sy = orient3d(p(d), p(e), p(z), p(y));
+        if sx == Sign::Zero || sy == Sign::Zero || sx == sy {
+            continue;
+        }
+        let orient = |w: u32, s: Sign| {
+            if s == Sign::Positive {
+                [d, e, z, w]
+            } else {
+                [e, d, z, w]
+            }
+        };
+        let made = vec![orient(x, sx), orient(y, sy)];
+        let (old, ids) = replace(mesh, vec![t, n, m], &made);
+        return Some(Flip { old, made, ids });
+    }
+    None
+}
+
+/// Replace the tets `old` by `made` (filling the same space), adjacency kept: the old slots in
+/// order, then new ones; returns the old tets and the slots of the new.
+fn replace(mesh: &mut TetMesh, mut old: Vec<u32>, made: &[[u32; 4]]) -> (Vec<u32>, Vec<u32>) {
+    old.sort_unstable();
+    let label = mesh.labels[old[0] as usize];
+    let inside = |s: u32| old.binary_search(&s).is_ok();
+    let (faces, outer) = cavity::shell(&old, &mesh.tets, &mesh.neighbors, inside);
+    let mut ids = Vec::with_capacity(made.len());
+    for (j, tet) in made.iter().enumerate() {
+        match old.get(j) {
+            Some(&s) => {
+                mesh.tets[s as usize] = *tet;
+                ids.push(s);
+            }
+            None => {
+                ids.push(mesh.tets.len() as u32);
+                mesh.tets.push(*tet);
+                mesh.labels.push(label);
+                mesh.neighbors.push([NO_NEIGHBOR; 4]);
+            }
+        }
+    }
+    cavity::stitch(&mesh.tets, &mut mesh.neighbors, &ids, &faces, &outer);
+    (old, ids)
 }
