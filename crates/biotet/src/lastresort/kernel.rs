@@ -12,7 +12,10 @@
 //! the Chebyshev centre of the kernel, by min-norm ascent, the direction smoothing uses), then
 //! decided exactly: it is returned only if `orient3d` puts it strictly on the inner side of
 //! every face. Of the first such point on the way and the deepest, the one whose cone has fewer
-//! tets under 10° (then the larger smallest dihedral angle) is returned. A cell whose kernel is empty, or so thin that the ascent misses it, gives `None`.
+//! tets under 10° (then the larger smallest dihedral angle) is returned. Where the ascent finds
+//! no point (it is first-order and stalls in a thin kernel of a long cell), the caller may ask
+//! for the Chebyshev centre by linear program, decided exactly the same way. A cell whose kernel
+//! is empty, or too thin for floating point, gives `None`.
 
 use crate::geom::filter::orient3d;
 use crate::geom::predicates::{Sign, in_exact_range};
@@ -28,7 +31,9 @@ const MAX_STEPS: usize = 200;
 /// A point strictly inside the kernel of the cell bounded by `faces` (indices into `points`,
 /// normals into the cell), or `None`. Exact: every returned point passes `orient3d > 0` against
 /// every face.
-pub(crate) fn kernel_point(points: &[P3], faces: &[[u32; 3]]) -> Option<P3> {
+/// With `exact_lp`, where the ascent finds no point the linear program is solved too (see
+/// [`chebyshev_centre`]).
+pub(crate) fn kernel_point(points: &[P3], faces: &[[u32; 3]], exact_lp: bool) -> Option<P3> {
     if faces.len() < 4 {
         return None;
     }
@@ -146,9 +151,123 @@ pub(crate) fn kernel_point(points: &[P3], faces: &[[u32; 3]]) -> Option<P3> {
                 a
             }
         }
+        // The ascent is first-order and stalls where the kernel is a thin sliver of a long
+        // cell (a cell reaching the enclosing box's corners, its kernel 10⁻⁴ of its size deep:
+        // tm_extrude_holes with a 300-tet first cavity bound). The linear program finds the
+        // deepest point wherever the kernel has an interior that floating point can resolve.
+        _ if exact_lp => chebyshev_centre(&planes, diameter2.sqrt()).filter(|&x| exact_ok(x))?,
         _ => return None,
     };
     Some(add(best, centre))
+}
+
+/// The Chebyshev centre of the kernel (the point deepest inside every plane `u·x ≥ d`, `u`
+/// unit), by the simplex method on the dual: maximise `d·y` over `y ≥ 0`, `Σ y = 1`,
+/// `Σ y u = 0`, whose optimal basis names the four planes the centre is equally deep in
+/// (Bland's rule: no cycling, so it terminates). `None` when the kernel has no interior (or
+/// the normals do not enclose it). Floating point; the caller decides exactly.
+fn chebyshev_centre(planes: &[(P3, f64)], scale: f64) -> Option<P3> {
+    let m = planes.len();
+    // (NaN fails `is_finite`.)
+    if m < 4 || scale <= 0.0 || !scale.is_finite() {
+        return None;
+    }
+    // Rows: Σ y u_k = 0 (k < 3), Σ y = 1; columns: y (m), then 4 artificials, then the
+    // right-hand side. Offsets in units of the cell's size (conditioning).
+    let cols = m + 4;
+    let mut tab = vec![[0.0f64; 4]; cols + 1];
+    for (j, &(u, _)) in planes.iter().enumerate() {
+        tab[j] = [u[0], u[1], u[2], 1.0];
+    }
+    for r in 0..4 {
+        tab[m + r][r] = 1.0;
+    }
+    tab[cols][3] = 1.0;
+    let cost: Vec<f64> = planes.iter().map(|&(_, d)| d / scale).collect();
+    let mut basis = [m, m + 1, m + 2, m + 3];
+    const EPS: f64 = 1e-12;
+    // Two phases: first drive the artificials out (maximise minus their sum), then maximise
+    // d·y. Column-major tableau, pivoting on rows.
+    for phase in 0..2 {
+        let obj = |j: usize| -> f64 {
+            if phase == 0 {
+                if j >= m { -1.0 } else { 0.0 }
+            } else if j >= m {
+                f64::NEG_INFINITY
+            } else {
+                cost[j]
+            }
+        };
+        for _ in 0..50 * cols {
+            // Reduced costs c_j - c_B·(column j in the current basis).
+            let cb = basis.map(&obj);
+            let entering = (0..cols).find(|&j| {
+                !basis.contains(&j) && {
+                    let c = obj(j);
+                    c.is_finite() && c - (0..4).map(|r| cb[r] * tab[j][r]).sum::<f64>() > EPS
+                }
+            });
+            let Some(e) = entering else { break };
+            // Ratio test (Bland: the smallest basis index among ties).
+            let mut leave: Option<(f64, usize)> = None;
+            for r in 0..4 {
+                let a = tab[e][r];
+                if a > EPS {
+                    let q = tab[cols][r] / a;
+                    let better = leave.is_none_or(|(lq, lr)| {
+                        q < lq - EPS || (q <= lq + EPS && basis[r] < basis[lr])
+                    });
+                    if better {
+                        leave = Some((q, r));
+                    }
+                }
+            }
+            let (_, r) = leave?;
+            let piv = tab[e][r];
+            for col in tab.iter_mut() {
+                col[r] /= piv;
+            }
+            let pc = tab[e];
+            for col in tab.iter_mut() {
+                let f = col[r];
+                for k in 0..4 {
+                    if k != r {
+                        col[k] -= pc[k] * f;
+                    }
+                }
+            }
+            basis[r] = e;
+        }
+        if phase == 0 && basis.iter().any(|&j| j >= m) {
+            // An artificial left in the basis: the origin is not a positive combination of
+            // the normals that spans space (no bounded kernel to centre).
+            return None;
+        }
+    }
+    // The centre and its depth t: u_j·x − t = d_j for the four basic planes.
+    let mut a = [[0.0f64; 5]; 4];
+    for (r, &j) in basis.iter().enumerate() {
+        let (u, d) = planes[j];
+        a[r] = [u[0], u[1], u[2], -1.0, d];
+    }
+    for c in 0..4 {
+        let p = (c..4).max_by(|&i, &k| a[i][c].abs().total_cmp(&a[k][c].abs()))?;
+        a.swap(c, p);
+        if a[c][c].abs() < EPS {
+            return None;
+        }
+        for i in 0..4 {
+            if i != c {
+                let f = a[i][c] / a[c][c];
+                let pivot_row = a[c];
+                for (x, &y) in a[i].iter_mut().zip(pivot_row.iter()).skip(c) {
+                    *x -= f * y;
+                }
+            }
+        }
+    }
+    let z = [0, 1, 2, 3].map(|i| a[i][4] / a[i][i]);
+    (z[3] > 0.0 && z.iter().all(|v| v.is_finite())).then_some([z[0], z[1], z[2]])
 }
 
 /// The cone from point `p` (index `apex`) over `faces`: one positively oriented tet per face
@@ -193,4 +312,52 @@ pub(crate) fn split_insert(points: &[P3], tets: &mut Vec<[u32; 4]>, x: u32) -> b
         // The pushed tets hold `x` and are skipped; `i` now holds an unvisited tet.
     }
     found
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A cell a thousand times longer than its kernel is deep (a corner of the enclosing box
+    /// far out, as in tm_extrude_holes's cavities): the linear program finds the kernel's
+    /// centre, and the point is exactly inside every face.
+    #[test]
+    fn a_long_thin_cell_has_its_kernel_point() {
+        // The tet (0,0,0), (1,0,0), (0,1,0), far apex; faces inward.
+        let pts = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [-640.0, -640.0, 640.5],
+        ];
+        let faces = [[0, 1, 2], [0, 3, 1], [1, 3, 2], [2, 3, 0]];
+        for f in &faces {
+            let [a, b, c] = f.map(|i| pts[i as usize]);
+            let inner = [0, 1, 2, 3].into_iter().find(|x| !f.contains(x)).unwrap();
+            assert_eq!(orient3d(a, b, c, pts[inner as usize]), Sign::Positive);
+        }
+        let p = kernel_point(&pts, &faces, true).expect("a kernel point");
+        for f in &faces {
+            let [a, b, c] = f.map(|i| pts[i as usize]);
+            assert_eq!(orient3d(a, b, c, p), Sign::Positive);
+        }
+        // The centre alone: equally deep in its four planes (the inradius).
+        let planes: Vec<(P3, f64)> = faces
+            .iter()
+            .map(|f| {
+                let [a, b, c] = f.map(|i| pts[i as usize]);
+                let n = cross(sub(b, a), sub(c, a));
+                let u = scale(n, 1.0 / norm2(n).sqrt());
+                (u, dot(u, a))
+            })
+            .collect();
+        let x = chebyshev_centre(&planes, 1000.0).expect("a centre");
+        let depths: Vec<f64> = planes.iter().map(|&(u, d)| dot(u, x) - d).collect();
+        let lo = depths.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = depths.iter().copied().fold(0.0, f64::max);
+        assert!(lo > 0.0 && hi - lo < 1e-9 * hi, "{depths:?}");
+        // No kernel: the tet's faces turned outward.
+        let out: Vec<(P3, f64)> = planes.iter().map(|&(u, d)| (scale(u, -1.0), -d)).collect();
+        assert!(chebyshev_centre(&out, 1000.0).is_none());
+    }
 }

@@ -954,3 +954,24 @@ fn steiner_points_outside_the_surface_are_dropped() {
     let c = check(&m, Some(&s));
     assert!(c.valid, "{c}");
 }
+
+/// A plate with a row of hexagonal holes (their walls nearly coplanar along each row): with a
+/// first cavity bound of 300 tets instead of the pipeline's 40, recovery's Steiner fallback met
+/// cells whose kernels are thin slivers of long cells reaching the enclosing box's corners,
+/// which the kernel point's ascent missed; the inset fallback then left 2 triangles and the run
+/// failed. The linear program finds those kernels.
+#[test]
+fn extrude_holes_meshes_with_large_first_cavities() {
+    let s = crate::common::load_shape("tm_extrude_holes.off");
+    let mut opts = biotet::pipeline::PipelineOptions::default();
+    if let Some(r) = opts.recover.as_mut() {
+        r.first_cavity_tets = 300;
+    }
+    let (m, report) = mesh_pipeline(&s, opts);
+    let r = report.recover.as_ref().unwrap();
+    assert!(r.is_complete(), "{:?}", r.unrecovered);
+    assert_eq!(report.missing_triangles, 0);
+    let c = check(&m, Some(&s));
+    assert!(c.valid, "{c}");
+    assert!((mesh_volume(&m) - enclosed_volume(&s)).abs() < 1e-9 * enclosed_volume(&s));
+}
