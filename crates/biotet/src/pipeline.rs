@@ -225,15 +225,21 @@ pub fn mesh_surface<S: Borrow<Sizing>>(
     let retry = steiner && !dep.interior_regions.is_empty() && kernels.is_none();
     // With nodes to clear, the first try skips the wide rounds (seconds where a retry takes
     // milliseconds); they come last, if clearing does not do.
-    // With the cones to follow, the first try keeps to its small cavities too: where those
-    // leave triangles, larger ones cost seconds (cubes of strip-cut faces) and the cones
-    // milliseconds.
+    // With the cones to follow, the first try keeps to its small cavities too, and ends at its
+    // first round that leaves triangles: where those leave triangles, larger cavities and more
+    // rounds cost seconds (cubes of strip-cut faces: 1.85 s -> 0.47 s, the same mesh) and the
+    // cones milliseconds.
     let first = opts.recover.map(|o| RecoverOptions {
         widen: o.widen && !retry && kernels.is_none(),
         max_cavity_tets: if kernels.is_some() {
             o.first_cavity_tets.min(o.max_cavity_tets)
         } else {
             o.max_cavity_tets
+        },
+        max_wide_rounds: if kernels.is_some() {
+            0
+        } else {
+            o.max_wide_rounds
         },
         ..o
     });
