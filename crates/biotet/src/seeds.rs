@@ -417,24 +417,8 @@ fn flip_face(mesh: &mut TetMesh, ns: usize, t: u32, i: usize) -> Option<Flip> {
 /// order, then new ones; returns the old tets and the slots of the new.
 fn replace(mesh: &mut TetMesh, mut old: Vec<u32>, made: &[[u32; 4]]) -> (Vec<u32>, Vec<u32>) {
     old.sort_unstable();
-    let label = mesh.labels[old[0] as usize];
     let inside = |s: u32| old.binary_search(&s).is_ok();
     let (faces, outer) = cavity::shell(&old, &mesh.tets, &mesh.neighbors, inside);
-    let mut ids = Vec::with_capacity(made.len());
-    for (j, tet) in made.iter().enumerate() {
-        match old.get(j) {
-            Some(&s) => {
-                mesh.tets[s as usize] = *tet;
-                ids.push(s);
-            }
-            None => {
-                ids.push(mesh.tets.len() as u32);
-                mesh.tets.push(*tet);
-                mesh.labels.push(label);
-                mesh.neighbors.push([NO_NEIGHBOR; 4]);
-            }
-        }
-    }
-    cavity::stitch(&mesh.tets, &mut mesh.neighbors, &ids, &faces, &outer);
+    let ids = cavity::fill_slots(mesh, &old, made, &faces, &outer);
     (old, ids)
 }

@@ -156,13 +156,27 @@ pub fn cone_valid(mesh: &TetMesh, cavity: &[u32], faces: &[[u32; 3]], x: [f64; 3
 pub fn cone_in(mesh: &mut TetMesh, x: [f64; 3], cavity: &[u32], dead: &mut Vec<u32>) {
     let p = mesh.points.len() as u32;
     mesh.points.push(x);
-    let label = mesh.labels[cavity[0] as usize];
     let inside = |t: u32| cavity.binary_search(&t).is_ok();
     let (faces, outer) = shell(cavity, &mesh.tets, &mesh.neighbors, inside);
-    let mut ids = Vec::with_capacity(faces.len());
-    for (j, f) in faces.iter().enumerate() {
-        // The shell's faces point into the cavity, at x.
-        let tet = [f[0], f[1], f[2], p];
+    // The shell's faces point into the cavity, at x.
+    let cone: Vec<[u32; 4]> = faces.iter().map(|f| [f[0], f[1], f[2], p]).collect();
+    fill_slots(mesh, cavity, &cone, &faces, &outer);
+    dead.extend(cavity.iter().skip(faces.len()));
+}
+
+/// Put `made` (filling the space of the tets `cavity`, sorted, whose shell is `faces` with the
+/// faces `outer` across, as [`shell`] gives them) into the mesh, adjacency kept: the cavity's slots in order, then new
+/// ones; returns the slots of `made`. Slots left over keep their old tets (the caller drops them).
+pub fn fill_slots(
+    mesh: &mut TetMesh,
+    cavity: &[u32],
+    made: &[[u32; 4]],
+    faces: &[[u32; 3]],
+    outer: &[(u32, u8)],
+) -> Vec<u32> {
+    let label = mesh.labels[cavity[0] as usize];
+    let mut ids = Vec::with_capacity(made.len());
+    for (j, &tet) in made.iter().enumerate() {
         match cavity.get(j) {
             Some(&s) => {
                 mesh.tets[s as usize] = tet;
@@ -176,8 +190,8 @@ pub fn cone_in(mesh: &mut TetMesh, x: [f64; 3], cavity: &[u32], dead: &mut Vec<u
             }
         }
     }
-    dead.extend(cavity.iter().skip(faces.len()));
-    stitch(&mesh.tets, &mut mesh.neighbors, &ids, &faces, &outer);
+    stitch(&mesh.tets, &mut mesh.neighbors, &ids, faces, outer);
+    ids
 }
 
 /// Where `x` lies against tet `t`: `Ok(true)` strictly inside, `Ok(false)` on its boundary,
