@@ -681,6 +681,9 @@ impl<'a> Work<'a> {
         }
         let label = self.labels[tet as usize];
         let lim = self.opts.forced_deg;
+        // Any poor input face forces here, a flat tet on one too (unlike the report's and
+        // polish's `face_forces`): refilling such tets from the first rounds left more tets under
+        // 10° (the hair torus 589 -> 634); polish's last pass takes them instead.
         let fixed = |n: u32| n == NO_NEIGHBOR || self.labels[n as usize] != label;
         for (i, l) in TET_FACES.iter().enumerate() {
             if fixed(self.nb[tet as usize][i]) {
