@@ -19,15 +19,16 @@
 //! corners are cospherical, so the Delaunay there is a tie), whose circumcentres lie outside it or
 //! too near its walls: those segments get no seed. A second pass flips the poor tets the first
 //! left towards Delaunay (Lawson 2-3 and 3-2 flips of faces between two tets of surface points,
-//! one of them poor, exact `insphere`), on a copy; the groups of flips that a seed's cavity there
-//! takes are made on the mesh, and the poor tets they made give seeds as above. The other flips
-//! are dropped: they only trade one poor tet for another.
+//! one of them poor, exact `insphere`) as a trial, undone from a log of the slots it changed;
+//! the groups of flips that a seed's cavity there takes are made again, and the poor tets they
+//! made give seeds as above. The other flips are dropped: they only trade one poor tet for
+//! another.
 //!
 //! The choice of points is floating point, as node placement is; every tet made is checked
 //! positive exactly. Sequential, in tet order: the same mesh on any number of threads.
 
 use rayon::prelude::*;
-use rustc_hash::FxHashSet;
+use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::geom::predicates::{Sign, insphere, orient3d};
 use crate::geom::vec3::{norm2, sub};
@@ -238,15 +239,20 @@ fn locate(mesh: &TetMesh, t: u32, x: P3) -> Option<u32> {
 ///
 /// Recovery can leave tets that span several segments of a tube (a twisted prism's, whose six
 /// corners are cospherical), with circumcentres outside it or too large for the clearance: the
-/// segments between get no seed. The flips are tried on a copy, and only the groups of flips
-/// (sharing tets) that a seed's cavity there takes are made on `mesh`: elsewhere a flip trades
-/// one poor tet for another, and the stages after fared worse with them.
+/// segments between get no seed. The flips are tried and undone ([`Undo`]), and only the groups
+/// of flips (sharing tets) that a seed's cavity there takes are made again: elsewhere a flip
+/// trades one poor tet for another, and the stages after fared worse with them.
 fn flip_and_seed(mesh: &mut TetMesh, ns: usize, bvh: &Bvh, left: &[u32]) -> usize {
-    let mut trial = mesh.clone();
-    let (flips, alive) = flip_towards_delaunay(&mut trial, ns, left);
+    // The trial flips are made on `mesh` itself and undone before the replay: the slots they
+    // touched are saved first (a copy of the mesh was a third of the stage's peak memory on
+    // brain_20k at --size 1).
+    let mut undo = Undo::new(mesh);
+    let (flips, alive) = flip_towards_delaunay(mesh, ns, left, &mut undo);
     if flips.is_empty() {
+        undo.restore(mesh);
         return 0;
     }
+    let trial = &*mesh;
     // Flips sharing a tet form a group; the group's last flip in a slot owns it.
     let mut groups = Dsu::new(flips.len());
     let mut owner = vec![u32::MAX; trial.tets.len()];
@@ -261,19 +267,21 @@ fn flip_and_seed(mesh: &mut TetMesh, ns: usize, bvh: &Bvh, left: &[u32]) -> usiz
         }
     }
     // Only the poor tets the flips made: the others had their chance in the first pass.
-    let bad = poor_surface_tets(&trial, ns)
+    let bad = poor_surface_tets(trial, ns)
         .into_iter()
         .filter(|&t| alive[t as usize] && owner[t as usize] != u32::MAX)
         .collect();
-    let seeds = choose(&trial, ns, bvh, bad);
+    let seeds = choose(trial, ns, bvh, bad);
     let mut used = vec![false; flips.len()];
     for &t in seeds.iter().flat_map(|s| &s.1) {
         if owner[t as usize] != u32::MAX {
             used[groups.find(owner[t as usize]) as usize] = true;
         }
     }
-    // The used groups' flips again, in order, on `mesh` (its slots mapped from the copy's).
     let mut slot: Vec<u32> = (0..trial.tets.len() as u32).collect();
+    undo.restore(mesh);
+    // The used groups' flips again, in order, on the restored mesh (its slots mapped from the
+    // trial's).
     let mut dead = Vec::new();
     let mut made = FxHashSet::default();
     for (f, flip) in flips.iter().enumerate() {
@@ -282,7 +290,7 @@ fn flip_and_seed(mesh: &mut TetMesh, ns: usize, bvh: &Bvh, left: &[u32]) -> usiz
         }
         made.extend(flip.made.iter().map(|&t| sorted(t)));
         let old = flip.old.iter().map(|&s| slot[s as usize]).collect();
-        let (old, ids) = replace(mesh, old, &flip.made);
+        let (old, ids) = replace(mesh, old, &flip.made, None);
         for (&t, &r) in flip.ids.iter().zip(&ids) {
             slot[t as usize] = r;
         }
@@ -316,7 +324,12 @@ struct Flip {
 /// strictly holds the other's far corner; from the tets `start`, then the new ones (sequential).
 /// The flips in order, and which slots hold a tet (the others are left for [`cavity::drop_dead`]).
 /// Adjacency is kept.
-fn flip_towards_delaunay(mesh: &mut TetMesh, ns: usize, start: &[u32]) -> (Vec<Flip>, Vec<bool>) {
+fn flip_towards_delaunay(
+    mesh: &mut TetMesh,
+    ns: usize,
+    start: &[u32],
+    undo: &mut Undo,
+) -> (Vec<Flip>, Vec<bool>) {
     let mut alive = vec![true; mesh.tets.len()];
     let mut stack: Vec<u32> = start.iter().rev().copied().collect();
     let mut flips = Vec::new();
@@ -324,7 +337,7 @@ fn flip_towards_delaunay(mesh: &mut TetMesh, ns: usize, start: &[u32]) -> (Vec<F
         if !alive[t as usize] {
             continue;
         }
-        if let Some(flip) = (0..4).find_map(|i| flip_face(mesh, ns, t, i)) {
+        if let Some(flip) = (0..4).find_map(|i| flip_face(mesh, ns, t, i, undo)) {
             alive.resize(mesh.tets.len(), true);
             for &s in &flip.old {
                 if !flip.ids.contains(&s) {
@@ -340,7 +353,7 @@ fn flip_towards_delaunay(mesh: &mut TetMesh, ns: usize, start: &[u32]) -> (Vec<F
 
 /// Flip the face of `t` opposite its corner `i` when the rule of [`flip_towards_delaunay`] asks
 /// for it and a 2-3 or 3-2 flip is valid.
-fn flip_face(mesh: &mut TetMesh, ns: usize, t: u32, i: usize) -> Option<Flip> {
+fn flip_face(mesh: &mut TetMesh, ns: usize, t: u32, i: usize, undo: &mut Undo) -> Option<Flip> {
     let n = mesh.neighbors[t as usize][i];
     if n == NO_NEIGHBOR || mesh.labels[n as usize] != mesh.labels[t as usize] {
         return None;
@@ -376,7 +389,7 @@ fn flip_face(mesh: &mut TetMesh, ns: usize, t: u32, i: usize) -> Option<Flip> {
                 }
             })
             .collect();
-        let (old, ids) = replace(mesh, vec![t, n], &made);
+        let (old, ids) = replace(mesh, vec![t, n], &made, Some(undo));
         return Some(Flip { old, made, ids });
     }
     // 3-2: an edge xy of the face has just these two tets and one more, {x, y, d, e}, around it
@@ -407,18 +420,136 @@ fn flip_face(mesh: &mut TetMesh, ns: usize, t: u32, i: usize) -> Option<Flip> {
             }
         };
         let made = vec![orient(x, sx), orient(y, sy)];
-        let (old, ids) = replace(mesh, vec![t, n, m], &made);
+        let (old, ids) = replace(mesh, vec![t, n, m], &made, Some(undo));
         return Some(Flip { old, made, ids });
     }
     None
 }
 
 /// Replace the tets `old` by `made` (filling the same space), adjacency kept: the old slots in
-/// order, then new ones; returns the old tets and the slots of the new.
-fn replace(mesh: &mut TetMesh, mut old: Vec<u32>, made: &[[u32; 4]]) -> (Vec<u32>, Vec<u32>) {
+/// order, then new ones; returns the old tets and the slots of the new. With `undo`, the slots
+/// it changes are saved there first.
+fn replace(
+    mesh: &mut TetMesh,
+    mut old: Vec<u32>,
+    made: &[[u32; 4]],
+    undo: Option<&mut Undo>,
+) -> (Vec<u32>, Vec<u32>) {
     old.sort_unstable();
     let inside = |s: u32| old.binary_search(&s).is_ok();
     let (faces, outer) = cavity::shell(&old, &mesh.tets, &mesh.neighbors, inside);
+    if let Some(undo) = undo {
+        // The cavity's slots are refilled, and the stitch rewrites the outer tets' adjacency.
+        for &s in old.iter().chain(outer.iter().map(|(n, _)| n)) {
+            undo.save(mesh, s);
+        }
+    }
     let ids = cavity::fill_slots(mesh, &old, made, &faces, &outer);
     (old, ids)
+}
+
+/// What trial changes to a mesh overwrote: the tets and adjacency of the slots that existed
+/// before them, each as it was when first changed, and how many tets there were. New slots are
+/// dropped on restoring; labels and points are never changed by [`replace`].
+struct Undo {
+    tets: usize,
+    saved: FxHashMap<u32, ([u32; 4], [u32; 4])>,
+}
+
+impl Undo {
+    fn new(mesh: &TetMesh) -> Undo {
+        Undo {
+            tets: mesh.tets.len(),
+            saved: FxHashMap::default(),
+        }
+    }
+
+    /// Save slot `s` unless it is new or already saved.
+    fn save(&mut self, mesh: &TetMesh, s: u32) {
+        if s != NO_NEIGHBOR && (s as usize) < self.tets {
+            self.saved
+                .entry(s)
+                .or_insert_with(|| (mesh.tets[s as usize], mesh.neighbors[s as usize]));
+        }
+    }
+
+    /// Put `mesh` back as it was when this was made.
+    fn restore(self, mesh: &mut TetMesh) {
+        for (s, (t, n)) in self.saved {
+            mesh.tets[s as usize] = t;
+            mesh.neighbors[s as usize] = n;
+        }
+        mesh.tets.truncate(self.tets);
+        mesh.neighbors.truncate(self.tets);
+        mesh.labels.truncate(self.tets);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pipeline::{PipelineOptions, mesh_surface};
+    use crate::sizing::{SizeSpec, Sizing, SizingOptions};
+
+    /// trimesh's ring tube of triangular section (`torus(1, 0.01, 200, 3)`) from the shape
+    /// corpus (an OFF file of triangles).
+    fn triangular_ring() -> SurfaceMesh {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../tests/data/shapes/tm_tri_torus.off"
+        );
+        let text = std::fs::read_to_string(path).expect("shape corpus");
+        let mut words = text.split_whitespace().skip(1);
+        let mut next = || words.next().expect("OFF");
+        let nv: usize = next().parse().unwrap();
+        let nf: usize = next().parse().unwrap();
+        next();
+        let points = (0..nv)
+            .map(|_| [0; 3].map(|_| next().parse::<f64>().unwrap()))
+            .collect();
+        let triangles = (0..nf)
+            .map(|_| {
+                assert_eq!(next(), "3");
+                [0; 3].map(|_| next().parse::<u32>().unwrap())
+            })
+            .collect();
+        SurfaceMesh::closed(points, triangles, 1)
+    }
+
+    /// The second pass's trial flips, undone from their log, leave the mesh as it was to the bit
+    /// (tets, adjacency, labels, and no slot left over), on the ring tube whose recovered tets
+    /// span segments (where the flips happen).
+    #[test]
+    fn trial_flips_are_undone_to_the_bit() {
+        let s = triangular_ring();
+        let sizing = Sizing::new(
+            &s,
+            SizingOptions::new(SizeSpec::FromSurface { grading: 0.3 }),
+        )
+        .unwrap();
+        let opts = PipelineOptions {
+            seeds: false,
+            improve: None,
+            smooth: None,
+            polish: None,
+            ..PipelineOptions::default()
+        };
+        let (mut mesh, report) = mesh_surface(&s, &sizing, &opts, &mut |_| {}).unwrap();
+        let ns = report.n_surface_points;
+        let bvh = Bvh::of_surface(&s);
+        let bad = poor_surface_tets(&mesh, ns);
+        seed_pass(&mut mesh, ns, &bvh, bad);
+        let left = poor_surface_tets(&mesh, ns);
+        let before = mesh.clone();
+        let mut undo = Undo::new(&mesh);
+        let (flips, _) = flip_towards_delaunay(&mut mesh, ns, &left, &mut undo);
+        assert!(!flips.is_empty(), "no trial flip on the ring tube");
+        assert!(
+            flips.iter().any(|f| f.ids.len() > f.old.len()),
+            "no 2-3 flip"
+        );
+        assert_ne!(mesh, before);
+        undo.restore(&mut mesh);
+        assert_eq!(mesh, before);
+    }
 }
