@@ -30,6 +30,7 @@ pub(super) struct Work {
     forced: Vec<u8>,
     free: Vec<u32>,
     forced_deg: f64,
+    needle_deg: f64,
     /// Which of polish's last passes runs ([`Work::insert`] accepts more in them).
     pub rescue: Rescue,
     /// Tets whose insertion was refused only for that count (the last pass retries these alone).
@@ -56,7 +57,7 @@ pub const DEEP_FLAT: f64 = 1e-3;
 pub const DEEP_FLOOR: f64 = 1e-2;
 
 impl Work {
-    pub fn new(mesh: &mut TetMesh, forced_deg: f64) -> Work {
+    pub fn new(mesh: &mut TetMesh, forced_deg: f64, needle_deg: f64) -> Work {
         let n = mesh.tets.len();
         let np = mesh.points.len();
         let mut w = Work {
@@ -70,6 +71,7 @@ impl Work {
             forced: vec![0; n],
             free: Vec::new(),
             forced_deg,
+            needle_deg,
             rescue: Rescue::Off,
             rescuable: Vec::new(),
         };
@@ -235,13 +237,14 @@ impl Work {
         }
         let label = self.labels[t as usize];
         let lim = self.forced_deg;
+        let needle = self.needle_deg.min(lim);
         for (i, l) in TET_FACES.iter().enumerate() {
             let n = self.nb[t as usize][i];
             if !self.outside(label, n) {
                 continue;
             }
             let a = min_angle_3d_deg(&l.map(|k| self.pts[tv[k] as usize]));
-            if a < lim && face_forces(a, self.min_angle(t), lim) {
+            if a < needle && face_forces(a, self.min_angle(t), lim) {
                 return true;
             }
         }

@@ -81,10 +81,11 @@ fn polish_improves_the_tetgen_brain_mesh() {
     let r = polish(&mut m, &PolishOptions::default());
     polish(&mut again, &PolishOptions::default());
     assert!(again == m, "deterministic");
-    // Its own count agrees with the quality report's.
-    assert_eq!(r.n_bad_before, bad0, "{r:?}");
+    // Its own count takes in the report's unforced tets and the ones on needles of 2° to 10°,
+    // which the report counts as forced.
+    assert!(r.n_bad_before > bad0, "{r:?}");
     let bad1 = unforced_bad(&m);
-    assert_eq!(r.n_bad_after, bad1, "{r:?}");
+    assert!(r.n_bad_after >= bad1, "{r:?}");
     assert!(bad1 * 2 < bad0, "at least halved: {r:?}");
     assert!(r.moves_accepted > 0 && r.removals_accepted > 0, "{r:?}");
     assert_all_positive(&m);
@@ -104,6 +105,42 @@ fn polish_improves_the_tetgen_brain_mesh() {
     assert!(c.valid, "{c}");
     let v1 = volume(&m);
     assert!((v1 - v0).abs() < 1e-9 * v0, "volume {v1} vs {v0}");
+}
+
+/// A tet on a needle of a few degrees is not forced to be poor: its apex can sit in front of the
+/// needle's short edge. Polishing TetGen's brain mesh with the needles of 2° to 10° taken as
+/// unforced (the default) leaves far fewer tets below 10° in all than with every needle under 10°
+/// taken as forcing, no more below 5°, and no more tets the report calls unforced.
+#[test]
+fn polish_finds_better_apexes_over_needles() {
+    let base = tetgen_brain();
+    let surface = load_stl("brain_20k.stl");
+    let below = |m: &TetMesh, deg: f64| (0..m.tets.len()).filter(|&t| min_deg(m, t) < deg).count();
+    let run = |needle_deg: f64| {
+        let mut m = base.clone();
+        polish(
+            &mut m,
+            &PolishOptions {
+                needle_deg,
+                ..PolishOptions::default()
+            },
+        );
+        m
+    };
+    let (old, new) = (run(10.0), run(PolishOptions::default().needle_deg));
+    let unforced = |m: &TetMesh| summarise(m, &classify(m, &surface, 10.0), 10.0);
+    let (uo, un) = (unforced(&old), unforced(&new));
+    assert!(
+        10 * below(&new, 10.0) < 8 * below(&old, 10.0),
+        "{} vs {}",
+        below(&new, 10.0),
+        below(&old, 10.0)
+    );
+    assert!(below(&new, 5.0) <= below(&old, 5.0));
+    assert!(un.n_unforced_dihedral_lt_10 <= uo.n_unforced_dihedral_lt_10);
+    assert_all_positive(&new);
+    let c = check(&new, Some(&surface));
+    assert!(c.valid, "{c}");
 }
 
 /// TetGen's brain mesh polished on one and on two threads: the same points and tets, bit for
@@ -208,6 +245,8 @@ fn polish_fixes_wedges_at_short_edges_of_the_tetgen_brain_mesh() {
             &mut m,
             &PolishOptions {
                 wedge,
+                // Every needle forcing: the comparison sees the wedge step alone.
+                needle_deg: 10.0,
                 ..PolishOptions::default()
             },
         );
