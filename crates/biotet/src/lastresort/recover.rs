@@ -1402,8 +1402,10 @@ impl View<'_> {
             );
             // A first, cheaper try among better tets only (ηe raised): fewer candidates, and
             // fewer slivers for the sliver removal that follows; the configured search if not.
-            let key = cell_key(&cav.points, faces, inner);
-            let result = if self.no_fill.contains(&key) {
+            // The key only where it is looked up or recorded (most cells: neither).
+            let known = !self.no_fill.is_empty()
+                && self.no_fill.contains(&cell_key(&cav.points, faces, inner));
+            let result = if known {
                 Err(SearchError::NoFill { nodes_visited: 0 })
             } else {
                 let mut first = None;
@@ -1424,6 +1426,11 @@ impl View<'_> {
                     Some(Err(e @ SearchError::NoFill { .. })) if !w.searcher.cut_by_quality() => {
                         Err(e)
                     }
+                    // The shell is loaded: searched again without loading it again.
+                    Some(Err(e @ (SearchError::NoFill { .. } | SearchError::Budget { .. }))) => {
+                        *nodes += nodes_of(&e);
+                        w.searcher.refill(&self.opts.search)
+                    }
                     Some(Err(e)) => {
                         *nodes += nodes_of(&e);
                         w.searcher
@@ -1436,7 +1443,7 @@ impl View<'_> {
                 // A complete search's proof holds for this cell in any later cavity (the
                 // options that bound the fills do not change; widening only adds nodes).
                 if matches!(result, Err(SearchError::NoFill { .. })) {
-                    w.proven.push(key);
+                    w.proven.push(cell_key(&cav.points, faces, inner));
                 }
                 result
             };

@@ -199,8 +199,6 @@ struct Cand {
     p: u32,
     /// q³ ([`q_cubed`]): candidates are ranked and bounded by it.
     q: f64,
-    /// [`UNCHECKED`], [`VALID`] or [`DEAD`].
-    state: u8,
     lo: P3,
     hi: P3,
     /// The planes of its three new faces once validated (row `u32::MAX` before): a valid
@@ -238,6 +236,9 @@ pub struct Searcher {
     global: Vec<u32>,
     faces: Vec<Face>,
     cands: Vec<Cand>,
+    /// Each candidate's state, [`UNCHECKED`], [`VALID`] or [`DEAD`] (apart from `cands`: the
+    /// filter of every added tet scans them).
+    state: Vec<u8>,
     map: FxHashMap<[u32; 3], u32>,
     /// Candidate state changes (candidate, its face, previous state), undone on backtracking.
     kill_log: Vec<(u32, u32, u8)>,
@@ -275,6 +276,15 @@ pub struct Searcher {
     edges: Vec<(u32, u32)>,
     /// Local point ids sorted by coordinates (the duplicate check).
     order: Vec<u32>,
+    /// Local id of each caller point (`u32::MAX`: not loaded) when the caller's array is small
+    /// next to the shell (`dense`): cheaper than sorting and binary searches.
+    local_of: Vec<u32>,
+    dense: bool,
+    /// Whether the last [`Self::load`] succeeded (for [`Self::refill`]).
+    loaded: bool,
+    /// The local points by x (large searches only, else empty): [`Self::contains_point`]
+    /// visits only those in the candidate's x range.
+    by_x: Vec<(P3, u32)>,
     /// The root's faces by shape, poorest first.
     root_order: Vec<(f64, u32)>,
     /// Rows of `orient`: one per triangle met (sorted corners), for the whole call: the points
@@ -289,6 +299,9 @@ pub struct Searcher {
     /// across it, and that face, when the region's wedge there is convex.
     wedge: [Option<u32>; 3],
 }
+
+/// Searches with more points than this index them by x for [`Searcher::contains_point`].
+const BY_X_MIN_POINTS: usize = 48;
 
 /// Marks a not yet computed entry of `Searcher::orient`.
 const UNKNOWN: i8 = 2;
@@ -414,7 +427,13 @@ fn same_set(a: [u32; 3], b: [u32; 3]) -> bool {
 
 #[inline]
 pub(super) fn boxes_apart(alo: P3, ahi: P3, blo: P3, bhi: P3) -> bool {
-    (0..3).any(|k| ahi[k] < blo[k] || bhi[k] < alo[k])
+    // Without short circuits: no branch per axis in the loops over the front.
+    (ahi[0] < blo[0])
+        | (bhi[0] < alo[0])
+        | (ahi[1] < blo[1])
+        | (bhi[1] < alo[1])
+        | (ahi[2] < blo[2])
+        | (bhi[2] < alo[2])
 }
 
 /// The four outward faces of tet `t` (the face table of [`crate::TET_FACES`]).
@@ -457,6 +476,25 @@ impl Searcher {
         opts: &SearchOptions,
     ) -> Result<Fill, SearchError> {
         self.load(points, shell, inner, !cfg!(debug_assertions))?;
+        self.run(opts)
+    }
+
+    /// [`Self::fill`] again on the shell, points and inner points of the last call, which
+    /// loaded successfully, with other options. Every search undoes its levels before it
+    /// returns, so the front is the loaded shell again, as a new load would make it; the
+    /// orientations cached so far are kept (the points are the same).
+    pub(crate) fn refill(&mut self, opts: &SearchOptions) -> Result<Fill, SearchError> {
+        debug_assert!(self.loaded && self.levels.is_empty());
+        self.cands.clear();
+        self.state.clear();
+        self.kill_log.clear();
+        self.removed_log.clear();
+        for f in &mut self.faces {
+            f.c0 = 0;
+            f.c1 = 0;
+            f.live = 0;
+            f.valid = 0;
+        }
         self.run(opts)
     }
 
@@ -541,19 +579,40 @@ impl Searcher {
         inner: &[u32],
         trusted: bool,
     ) -> Result<(), SearchError> {
+        self.loaded = false;
         if shell.is_empty() {
             return Err(SearchError::Empty);
         }
         let n = points.len();
         self.global.clear();
-        for &i in shell.iter().flatten().chain(inner) {
-            if i as usize >= n {
-                return Err(SearchError::IndexOutOfRange { index: i, n });
+        // A cavity's own point array (recovery): mark the used points and number them in
+        // order, the same local ids as sorting them.
+        self.dense = n <= 4 * (3 * shell.len() + inner.len()) + 64;
+        if self.dense {
+            self.local_of.clear();
+            self.local_of.resize(n, u32::MAX);
+            for &i in shell.iter().flatten().chain(inner) {
+                if i as usize >= n {
+                    return Err(SearchError::IndexOutOfRange { index: i, n });
+                }
+                self.local_of[i as usize] = 0;
             }
-            self.global.push(i);
+            for (g, l) in self.local_of.iter_mut().enumerate() {
+                if *l != u32::MAX {
+                    *l = self.global.len() as u32;
+                    self.global.push(g as u32);
+                }
+            }
+        } else {
+            for &i in shell.iter().flatten().chain(inner) {
+                if i as usize >= n {
+                    return Err(SearchError::IndexOutOfRange { index: i, n });
+                }
+                self.global.push(i);
+            }
+            self.global.sort_unstable();
+            self.global.dedup();
         }
-        self.global.sort_unstable();
-        self.global.dedup();
         self.pts.clear();
         for &g in &self.global {
             let p = points[g as usize];
@@ -562,11 +621,11 @@ impl Searcher {
             }
             self.pts.push(p);
         }
-        let local = |g: u32, global: &[u32]| global.binary_search(&g).unwrap_or(0) as u32;
         self.scratch.clear();
         if trusted {
-            self.scratch
-                .extend(shell.iter().map(|f| f.map(|g| local(g, &self.global))));
+            let mut scratch = std::mem::take(&mut self.scratch);
+            scratch.extend(shell.iter().map(|f| f.map(|g| self.local(g))));
+            self.scratch = scratch;
         } else {
             self.check(shell)?;
         }
@@ -581,6 +640,7 @@ impl Searcher {
         self.row_keys.clear();
         self.faces.clear();
         self.cands.clear();
+        self.state.clear();
         reset_map(&mut self.map, want);
         self.kill_log.clear();
         self.removed_log.clear();
@@ -599,7 +659,25 @@ impl Searcher {
             self.push_face(f);
         }
         self.scratch = scratch;
+        self.by_x.clear();
+        if np > BY_X_MIN_POINTS {
+            self.by_x
+                .extend(self.pts.iter().enumerate().map(|(i, p)| (*p, i as u32)));
+            self.by_x
+                .sort_unstable_by(|a, b| a.0[0].total_cmp(&b.0[0]).then(a.1.cmp(&b.1)));
+        }
+        self.loaded = true;
         Ok(())
+    }
+
+    /// Caller point → local id, for a loaded caller point.
+    #[inline]
+    fn local(&self, g: u32) -> u32 {
+        if self.dense {
+            self.local_of[g as usize]
+        } else {
+            self.global.binary_search(&g).unwrap_or(0) as u32
+        }
     }
 
     /// The checks [`Self::fill_carved`] skips: distinct points, non-degenerate shell triangles
@@ -619,15 +697,17 @@ impl Searcher {
                 });
             }
         }
-        let local = |g: u32, global: &[u32]| global.binary_search(&g).unwrap_or(0) as u32;
+        let mut scratch = std::mem::take(&mut self.scratch);
         for (i, f) in shell.iter().enumerate() {
-            let l = f.map(|g| local(g, &self.global));
+            let l = f.map(|g| self.local(g));
             let c = l.map(|v| self.pts[v as usize]);
             if l[0] == l[1] || l[1] == l[2] || l[0] == l[2] || is_degenerate(&c) {
+                self.scratch = scratch;
                 return Err(SearchError::DegenerateFace { face: i });
             }
-            self.scratch.push(l);
+            scratch.push(l);
         }
+        self.scratch = scratch;
         // Closed: every directed edge matched by its reverse.
         self.edges.clear();
         for f in &self.scratch {
@@ -836,8 +916,28 @@ impl Searcher {
         let shared = g.iter().filter(|x| f.contains(x)).count();
         let coplanar = sg.iter().all(|&x| x == Sign::Zero);
         if shared == 0 && !coplanar {
-            return (0..3).any(|k| self.seg_meets(f[k], f[(k + 1) % 3], sf[k], sf[(k + 1) % 3], g))
-                || (0..3).any(|k| self.seg_meets(g[k], g[(k + 1) % 3], sg[k], sg[(k + 1) % 3], f));
+            // Both directions need the orientation of each edge of f against each edge of g
+            // (orient3d(a, b, c, d) = orient3d(c, d, a, b)): each is computed once.
+            let memo = [const { Cell::new(UNKNOWN) }; 9];
+            let edges = |k: usize, i: usize| {
+                let m = &memo[3 * k + i];
+                if m.get() == UNKNOWN {
+                    let s = self.o4(f[k], f[(k + 1) % 3], g[i], g[(i + 1) % 3]);
+                    m.set(s.as_i32() as i8);
+                }
+                match m.get() {
+                    1 => Sign::Positive,
+                    -1 => Sign::Negative,
+                    _ => Sign::Zero,
+                }
+            };
+            return (0..3).any(|k| {
+                let (k1, s) = ((k + 1) % 3, (sf[k], sf[(k + 1) % 3]));
+                self.seg_meets(f[k], f[k1], s, g, |i| edges(k, i))
+            }) || (0..3).any(|k| {
+                let (k1, s) = ((k + 1) % 3, (sg[k], sg[(k + 1) % 3]));
+                self.seg_meets(g[k], g[k1], s, f, |j| edges(j, k))
+            });
         }
         let fp = f.map(|x| self.pts[x as usize]);
         let gp = g.map(|x| self.pts[x as usize]);
@@ -846,8 +946,16 @@ impl Searcher {
 
     /// Does segment `xy` meet the closed triangle `t` (no corner shared)? `sx`, `sy`: the exact
     /// orientations of `x`, `y` against `t` in its own orientation (every plane passed to
-    /// [`Self::tri_conflict`] is oriented like its triangle).
-    fn seg_meets(&self, x: u32, y: u32, sx: Sign, sy: Sign, t: [u32; 3]) -> bool {
+    /// [`Self::tri_conflict`] is oriented like its triangle); `edge(i)`: orient3d(x, y, t[i],
+    /// t[i + 1]).
+    fn seg_meets(
+        &self,
+        x: u32,
+        y: u32,
+        (sx, sy): (Sign, Sign),
+        t: [u32; 3],
+        edge: impl Fn(usize) -> Sign,
+    ) -> bool {
         if sx != Sign::Zero && sx == sy {
             return false;
         }
@@ -859,9 +967,9 @@ impl Searcher {
         // The line crosses the plane at one point; its barycentric signs are the orientations
         // of the line against the triangle's edges, times the sign of its direction · normal.
         let dn_positive = sy == Sign::Positive || sx == Sign::Negative;
-        [(t[1], t[2]), (t[2], t[0]), (t[0], t[1])]
+        [1, 2, 0]
             .iter()
-            .all(|&(a, b)| self.o4(x, y, a, b).times(dn_positive) != Sign::Negative)
+            .all(|&i| edge(i).times(dn_positive) != Sign::Negative)
     }
 
     /// Plain exact orientation of four distinct points.
@@ -944,13 +1052,13 @@ impl Searcher {
             self.cands.push(Cand {
                 p,
                 q,
-                state: UNCHECKED,
                 lo,
                 hi,
                 planes: [NO_PLANE; 3],
             });
         }
         self.cands[start..].sort_by(|x, y| y.q.total_cmp(&x.q).then(x.p.cmp(&y.p)));
+        self.state.resize(self.cands.len(), UNCHECKED);
         let face = &mut self.faces[f];
         face.c0 = start as u32;
         face.c1 = self.cands.len() as u32;
@@ -1002,16 +1110,16 @@ impl Searcher {
 
     /// Set the state of candidate `k` of face `f`, logged for [`Self::undo`].
     fn set_state(&mut self, f: u32, k: u32, new: u8) {
-        let old = self.cands[k as usize].state;
+        let old = self.state[k as usize];
         self.kill_log.push((k, f, old));
         self.restate(f, k, new);
     }
 
     /// Set a candidate's state and keep its face's counts.
     fn restate(&mut self, f: u32, k: u32, new: u8) {
-        let c = &mut self.cands[k as usize];
+        let state = &mut self.state[k as usize];
         let face = &mut self.faces[f as usize];
-        match c.state {
+        match *state {
             VALID => face.valid -= 1,
             DEAD => face.live += 1,
             _ => {}
@@ -1021,7 +1129,7 @@ impl Searcher {
             DEAD => face.live -= 1,
             _ => {}
         }
-        c.state = new;
+        *state = new;
     }
 
     /// The number of candidates of face `f` with quality above the bound, exact when below
@@ -1040,7 +1148,7 @@ impl Searcher {
             if c.q <= self.bound {
                 break;
             }
-            n += match c.state {
+            n += match self.state[k as usize] {
                 VALID => 1,
                 UNCHECKED => self.validate(f, k) as u32,
                 _ => 0,
@@ -1098,24 +1206,25 @@ impl Searcher {
 
     /// Does the closed tet `t` contain a usable point other than its corners?
     fn contains_point(&self, t: [u32; 4], planes: &[Plane; 4], lo: P3, hi: P3) -> bool {
-        for r in 0..self.pts.len() as u32 {
-            if t.contains(&r) || !self.usable(r) {
-                continue;
-            }
-            let x = self.pts[r as usize];
-            if (0..3).any(|k| x[k] < lo[k] || x[k] > hi[k]) {
-                continue;
+        // Whether any point is inside: the order of the visits does not matter.
+        let test = |r: u32, x: P3| {
+            if (0..3).any(|k| x[k] < lo[k] || x[k] > hi[k]) || t.contains(&r) || !self.usable(r) {
+                return false;
             }
             // The base plane first: cached.
-            if planes
+            planes
                 .iter()
                 .rev()
                 .all(|&pl| self.outer(pl, r) != Sign::Positive)
-            {
-                return true;
-            }
+        };
+        if self.by_x.is_empty() {
+            return (0..self.pts.len() as u32).any(|r| test(r, self.pts[r as usize]));
         }
-        false
+        let a = self.by_x.partition_point(|e| e.0[0] < lo[0]);
+        self.by_x[a..]
+            .iter()
+            .take_while(|e| e.0[0] <= hi[0])
+            .any(|&(x, r)| test(r, x))
     }
 
     /// Does the candidate tet `t` (built on alive face `base`) meet another active face
@@ -1257,12 +1366,23 @@ impl Searcher {
             if f >= first_new || fr.valid == 0 {
                 continue;
             }
+            // Its valid candidates, counted: the rest of its range need not be read (the valid
+            // ones, checked best first, come early in it).
+            let mut left = fr.valid;
             for k in fr.c0..fr.c1 {
-                let c = self.cands[k as usize];
-                if c.state != VALID || boxes_apart(c.lo, c.hi, tlo, thi) {
+                if left == 0 {
+                    break;
+                }
+                if self.state[k as usize] != VALID {
                     continue;
                 }
-                let ct = [fr.v[0], fr.v[1], fr.v[2], c.p];
+                left -= 1;
+                let c = &self.cands[k as usize];
+                if boxes_apart(c.lo, c.hi, tlo, thi) {
+                    continue;
+                }
+                let p = c.p;
+                let ct = [fr.v[0], fr.v[1], fr.v[2], p];
                 let (cf, cp) = self.cand_planes(f as u32, k);
                 if self.tets_conflict(ct, &cf, &cp, t, &tf, &tp) {
                     self.set_state(f as u32, k, DEAD);
@@ -1297,6 +1417,7 @@ impl Searcher {
             }
         }
         self.cands.truncate(l.cands_len as usize);
+        self.state.truncate(l.cands_len as usize);
         while self.removed_log.len() > l.removed_len as usize {
             if let Some(f) = self.removed_log.pop() {
                 self.revive_face(f);
@@ -1376,7 +1497,8 @@ impl Searcher {
             if c.q <= self.bound {
                 break;
             }
-            if c.state == DEAD || (c.state == UNCHECKED && !self.validate(f as u32, k)) {
+            let st = self.state[k as usize];
+            if st == DEAD || (st == UNCHECKED && !self.validate(f as u32, k)) {
                 continue;
             }
             self.apply(f as u32, k);
