@@ -50,35 +50,42 @@ impl Default for Hint {
 
 impl Hint {
     /// Put `k` first.
+    #[inline]
     fn note(&mut self, k: u32) {
         let at = self.0.iter().position(|&x| x == k).unwrap_or(HINTS - 1);
-        self.0.copy_within(0..at, 1);
-        self.0[0] = k;
+        // Mostly the first hint answers again: nothing moves.
+        if at > 0 {
+            self.0.copy_within(0..at, 1);
+            self.0[0] = k;
+        }
     }
 }
 
-/// The nodes still to visit in a depth-first descent: a median split keeps the tree's depth
-/// under 64 for any `u32` count, and a descent holds at most the depth plus one, so a fixed
-/// array serves without allocating.
+/// The nodes still to visit in a depth-first descent, each with its box's squared distance to
+/// the query point (computed once, when its parent is opened): a median split keeps the tree's
+/// depth under 64 for any `u32` count, and a descent holds at most the depth plus one, so a
+/// fixed array serves without allocating.
 struct NodeStack {
-    nodes: [u32; 64],
+    nodes: [(u32, f64); 64],
     len: usize,
 }
 
 impl NodeStack {
-    fn root() -> NodeStack {
+    fn new() -> NodeStack {
         NodeStack {
-            nodes: [0; 64],
-            len: 1,
+            nodes: [(0, 0.0); 64],
+            len: 0,
         }
     }
 
-    fn push(&mut self, i: u32) {
-        self.nodes[self.len] = i;
+    #[inline]
+    fn push(&mut self, i: u32, d2: f64) {
+        self.nodes[self.len] = (i, d2);
         self.len += 1;
     }
 
-    fn pop(&mut self) -> Option<u32> {
+    #[inline]
+    fn pop(&mut self) -> Option<(u32, f64)> {
         self.len = self.len.checked_sub(1)?;
         Some(self.nodes[self.len])
     }
@@ -98,7 +105,7 @@ pub struct Bvh {
 /// A triangle's box and unnormalized normal (and its squared length): the two cheap rejections
 /// of [`within_d2`], precomputed with the same arithmetic so the answers are the same.
 #[derive(Debug, Clone, Copy)]
-struct Pre {
+pub(super) struct Pre {
     lo: P3,
     hi: P3,
     n: P3,
@@ -114,7 +121,7 @@ fn tri_box(t: &[P3; 3]) -> (P3, P3) {
 }
 
 impl Pre {
-    fn new(t: &[P3; 3]) -> Pre {
+    pub(super) fn new(t: &[P3; 3]) -> Pre {
         let (lo, hi) = tri_box(t);
         let n = cross(sub(t[1], t[0]), sub(t[2], t[0]));
         Pre {
@@ -147,7 +154,7 @@ fn within_d2_plane(p: P3, t: &[P3; 3], n: P3, nn: f64, r2: f64) -> Option<f64> {
 
 /// [`within_d2`] with the rejections' data precomputed.
 #[inline]
-fn within_d2_pre(p: P3, t: &[P3; 3], pre: &Pre, r: f64, r2: f64) -> Option<f64> {
+pub(super) fn within_d2_pre(p: P3, t: &[P3; 3], pre: &Pre, r: f64, r2: f64) -> Option<f64> {
     if outside_box(p, pre.lo, pre.hi, r) {
         return None;
     }
@@ -260,16 +267,17 @@ pub fn longest_edge(c: &[P3; 3]) -> f64 {
 }
 
 /// The squared distance from `p` to the box `lo..hi` (0 inside).
+///
+/// Without branches: for `lo <= hi` the larger of `lo - p`, `p - hi` and 0 is the per-axis gap
+/// the comparisons would pick, the same subtraction to the bit (and 0 for a NaN coordinate, as
+/// there); the query points fall either side of a box at random, so branches mispredict.
+#[inline]
 pub(super) fn box_d2(p: P3, lo: P3, hi: P3) -> f64 {
     let mut s = 0.0;
     for k in 0..3 {
-        let e = if p[k] < lo[k] {
-            lo[k] - p[k]
-        } else if p[k] > hi[k] {
-            p[k] - hi[k]
-        } else {
-            0.0
-        };
+        let (a, b) = (lo[k] - p[k], p[k] - hi[k]);
+        let e = if a > b { a } else { b };
+        let e = if e > 0.0 { e } else { 0.0 };
         s += e * e;
     }
     s
@@ -334,12 +342,21 @@ impl Bvh {
             triangle: u32::MAX,
             slot: u32::MAX,
         };
-        let mut stack = NodeStack::root();
-        while let Some(i) = stack.pop() {
-            let node = &self.nodes[i as usize];
-            if box_d2(p, node.lo, node.hi) >= best.d2 {
+        // A node's distance is taken when its parent is opened and it is pushed only if it may
+        // hold a closer point; the best distance only shrinks, so the test again at its turn
+        // skips what the test at its turn alone skipped, in the same order.
+        let root = &self.nodes[0];
+        let d = box_d2(p, root.lo, root.hi);
+        if d >= best.d2 {
+            return None;
+        }
+        let mut stack = NodeStack::new();
+        stack.push(0, d);
+        while let Some((i, d)) = stack.pop() {
+            if d >= best.d2 {
                 continue;
             }
+            let node = &self.nodes[i as usize];
             if node.count > 0 {
                 for k in node.start..node.start + node.count {
                     let q = closest_on_triangle(p, &self.tris[k as usize]);
@@ -354,24 +371,39 @@ impl Bvh {
                     }
                 }
             } else {
-                self.push_children(p, i, node.start, &mut stack);
+                let bound = best.d2;
+                self.push_children(p, i, node.start, &mut stack, |d| d >= bound);
             }
         }
         (best.triangle != u32::MAX).then_some(best)
     }
 
-    /// Push the children of inner node `i` (left `i + 1`, right `r`), the nearer to `p` last so
-    /// that it is popped first.
-    fn push_children(&self, p: P3, i: u32, r: u32, stack: &mut NodeStack) {
+    /// Push the children of inner node `i` (left `i + 1`, right `r`) with their distances to
+    /// `p`, the nearer last so that it is popped first, leaving out those `skip` says a pop
+    /// would skip.
+    #[inline]
+    fn push_children(
+        &self,
+        p: P3,
+        i: u32,
+        r: u32,
+        stack: &mut NodeStack,
+        skip: impl Fn(f64) -> bool,
+    ) {
         let l = i + 1;
-        let dl = box_d2(p, self.nodes[l as usize].lo, self.nodes[l as usize].hi);
-        let dr = box_d2(p, self.nodes[r as usize].lo, self.nodes[r as usize].hi);
-        if dl <= dr {
-            stack.push(r);
-            stack.push(l);
+        let (nl, nr) = (&self.nodes[l as usize], &self.nodes[r as usize]);
+        let dl = box_d2(p, nl.lo, nl.hi);
+        let dr = box_d2(p, nr.lo, nr.hi);
+        let (first, second) = if dl <= dr {
+            ((r, dr), (l, dl))
         } else {
-            stack.push(l);
-            stack.push(r);
+            ((l, dl), (r, dr))
+        };
+        if !skip(first.1) {
+            stack.push(first.0, first.1);
+        }
+        if !skip(second.1) {
+            stack.push(second.0, second.1);
         }
     }
 
@@ -416,12 +448,17 @@ impl Bvh {
                 return Some((d2, k));
             }
         }
-        let mut stack = NodeStack::root();
-        while let Some(i) = stack.pop() {
+        // Nodes farther than `r` are not pushed rather than skipped when popped: the same
+        // nodes are searched in the same order.
+        let root = &self.nodes[0];
+        let d = box_d2(p, root.lo, root.hi);
+        if d > r2 {
+            return None;
+        }
+        let mut stack = NodeStack::new();
+        stack.push(0, d);
+        while let Some((i, _)) = stack.pop() {
             let node = &self.nodes[i as usize];
-            if box_d2(p, node.lo, node.hi) > r2 {
-                continue;
-            }
             if node.count > 0 {
                 for k in node.start..node.start + node.count {
                     let (t, pre) = (&self.tris[k as usize], &self.pre[k as usize]);
@@ -431,7 +468,7 @@ impl Bvh {
                     }
                 }
             } else {
-                self.push_children(p, i, node.start, &mut stack);
+                self.push_children(p, i, node.start, &mut stack, |d| d > r2);
             }
         }
         None

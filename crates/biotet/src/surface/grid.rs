@@ -1,7 +1,9 @@
 //! A hashed uniform grid of the triangles being remeshed, updated as they change: the
 //! candidates for the exact intersection test of every new triangle. Each triangle is listed in
 //! every cell its bounding box overlaps; the box cells are remembered so removal does not need
-//! the (possibly moved) coordinates.
+//! the (possibly moved) coordinates. Each cell's entry carries the triangle's first cell, so a
+//! query lists a triangle only in the first cell of its box within the query's (no repeats to
+//! sort away).
 
 use crate::geom::vec3::bbox;
 use rustc_hash::FxHashMap;
@@ -13,7 +15,7 @@ type Cells = ([i32; 3], [i32; 3]);
 #[derive(Debug, Clone, Default)]
 pub struct Grid {
     h: f64,
-    cells: FxHashMap<[i32; 3], Vec<u32>>,
+    cells: FxHashMap<[i32; 3], Vec<(u32, [i32; 3])>>,
     of: Vec<Option<Cells>>,
 }
 
@@ -50,7 +52,7 @@ impl Grid {
         for i in r.0[0]..=r.1[0] {
             for j in r.0[1]..=r.1[1] {
                 for k in r.0[2]..=r.1[2] {
-                    self.cells.entry([i, j, k]).or_default().push(t);
+                    self.cells.entry([i, j, k]).or_default().push((t, r.0));
                 }
             }
         }
@@ -71,7 +73,7 @@ impl Grid {
             for j in r.0[1]..=r.1[1] {
                 for k in r.0[2]..=r.1[2] {
                     if let Some(v) = self.cells.get_mut(&[i, j, k])
-                        && let Some(p) = v.iter().position(|&x| x == t)
+                        && let Some(p) = v.iter().position(|&x| x.0 == t)
                     {
                         v.swap_remove(p);
                     }
@@ -83,17 +85,37 @@ impl Grid {
     /// The triangles whose boxes' cells overlap the box `lo..hi`, sorted, without repeats.
     pub fn query(&self, lo: P3, hi: P3, out: &mut Vec<u32>) {
         out.clear();
+        self.any(lo, hi, |t| {
+            out.push(t);
+            false
+        });
+        out.sort_unstable();
+    }
+
+    /// Whether `f` is true for one of the triangles [`Self::query`] lists, each offered once,
+    /// in no particular order (stops at the first).
+    #[inline]
+    pub fn any(&self, lo: P3, hi: P3, mut f: impl FnMut(u32) -> bool) -> bool {
         let r = self.range(lo, hi);
         for i in r.0[0]..=r.1[0] {
             for j in r.0[1]..=r.1[1] {
                 for k in r.0[2]..=r.1[2] {
-                    if let Some(v) = self.cells.get(&[i, j, k]) {
-                        out.extend_from_slice(v);
+                    let Some(v) = self.cells.get(&[i, j, k]) else {
+                        continue;
+                    };
+                    for &(t, first) in v {
+                        // The first cell of the triangle's box within the query's.
+                        if i == first[0].max(r.0[0])
+                            && j == first[1].max(r.0[1])
+                            && k == first[2].max(r.0[2])
+                            && f(t)
+                        {
+                            return true;
+                        }
                     }
                 }
             }
         }
-        out.sort_unstable();
-        out.dedup();
+        false
     }
 }

@@ -27,8 +27,8 @@
 use rustc_hash::{FxHashMap, FxHashSet};
 
 use super::bvh::{
-    Hint, PatchIndex, closest_on_segment, closest_on_triangle, dist2, longest_edge, unit_normal,
-    within, within_d2,
+    Hint, PatchIndex, Pre, closest_on_segment, closest_on_triangle, dist2, longest_edge,
+    unit_normal, within, within_d2, within_d2_pre,
 };
 use super::features::{Features, key};
 use super::grid::Grid;
@@ -450,6 +450,12 @@ impl<'a> Remesher<'a> {
         let lim = tol * (1.0 - 1e-9);
         let mut plan = Vec::new();
         let mut cand = Vec::new();
+        // What `within_d2` computes per triangle before measuring, once per new triangle.
+        let pre: Vec<([u32; 2], Pre)> = new
+            .iter()
+            .zip(new_ids)
+            .map(|((_, c), &t)| (self.sides[t as usize], Pre::new(c)))
+            .collect();
         // The new triangle that covered the last sample is tried first (neighbouring samples
         // mostly share it).
         let mut last = 0;
@@ -463,8 +469,9 @@ impl<'a> Remesher<'a> {
                 let p = self.samples.pts[s as usize];
                 let sides = self.samples.sides[s as usize];
                 let near_new = |k: usize| {
-                    if self.sides[new_ids[k] as usize] == sides {
-                        within_d2(p, &new[k].1, tol, t2)
+                    let (side, pre) = &pre[k];
+                    if *side == sides {
+                        within_d2_pre(p, &new[k].1, pre, tol, t2)
                     } else {
                         None
                     }
@@ -536,24 +543,19 @@ impl<'a> Remesher<'a> {
         }) else {
             return false;
         };
-        let mut cand = Vec::new();
-        self.grid.query(lo, hi, &mut cand);
-        for &u in &cand {
+        // The answer is whether any pair meets: the order the candidates come in does not
+        // matter.
+        self.grid.any(lo, hi, |u| {
             if !self.alive[u as usize] || ignore.contains(&u) {
-                continue;
+                return false;
             }
             let d = self.corners(u);
             let (dlo, dhi) = bbox(&d);
-            for ((ci, c), (lo, hi)) in new.iter().zip(&boxes) {
-                if (0..3).any(|k| dlo[k] > hi[k] || dhi[k] < lo[k]) {
-                    continue;
-                }
-                if meet_improperly(c, *ci, &d, self.tris[u as usize]) {
-                    return true;
-                }
-            }
-        }
-        false
+            new.iter().zip(&boxes).any(|((ci, c), (lo, hi))| {
+                !(0..3).any(|k| dlo[k] > hi[k] || dhi[k] < lo[k])
+                    && meet_improperly(c, *ci, &d, self.tris[u as usize])
+            })
+        })
     }
 
     /// Shape and orientation of the proposed triangles against the ones they replace: each
