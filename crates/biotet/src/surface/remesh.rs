@@ -341,11 +341,14 @@ impl<'a> Remesher<'a> {
     }
 
     fn neighbours(&self, v: u32) -> Vec<u32> {
-        let mut n: Vec<u32> = self.vt[v as usize]
-            .iter()
-            .flat_map(|&t| self.tris[t as usize])
-            .filter(|&x| x != v)
-            .collect();
+        let fan = &self.vt[v as usize];
+        // Sized up front: growing it from empty reallocated twice a call.
+        let mut n: Vec<u32> = Vec::with_capacity(2 * fan.len());
+        n.extend(
+            fan.iter()
+                .flat_map(|&t| self.tris[t as usize])
+                .filter(|&x| x != v),
+        );
         n.sort_unstable();
         n.dedup();
         n
@@ -414,19 +417,18 @@ impl<'a> Remesher<'a> {
         // One hint over the fan: its triangles are answered by the same few input triangles
         // (the hint speeds the answer and does not change it).
         let mut hint = Hint::default();
-        new.iter()
-            .zip(ids)
-            .map(|((tri, c), &t)| {
-                let n = self.sample_count(c);
-                let (d, dn) = self.dev[t as usize];
-                let known = moved.and_then(|(v, m)| {
-                    let corner = tri.iter().position(|&x| x == v)?;
-                    (dn == n).then_some((corner, d, m))
-                });
-                self.near_input(c, self.sides[t as usize], n, known, &mut hint)
-                    .map(|d| (d, n))
-            })
-            .collect()
+        let mut devs = Vec::with_capacity(new.len());
+        for ((tri, c), &t) in new.iter().zip(ids) {
+            let n = self.sample_count(c);
+            let (d, dn) = self.dev[t as usize];
+            let known = moved.and_then(|(v, m)| {
+                let corner = tri.iter().position(|&x| x == v)?;
+                (dn == n).then_some((corner, d, m))
+            });
+            let d = self.near_input(c, self.sides[t as usize], n, known, &mut hint)?;
+            devs.push((d, n));
+        }
+        Some(devs)
     }
 
     /// The new covers of the input samples covered by the triangles `old` when they are
@@ -448,7 +450,7 @@ impl<'a> Remesher<'a> {
         let tol = self.tol;
         let t2 = tol * tol;
         let lim = tol * (1.0 - 1e-9);
-        let mut plan = Vec::new();
+        let mut plan = Vec::with_capacity(old.iter().map(|&t| self.covers[t as usize].len()).sum());
         let mut cand = Vec::new();
         // What `within_d2` computes per triangle before measuring, once per new triangle.
         let pre: Vec<([u32; 2], Pre)> = new
