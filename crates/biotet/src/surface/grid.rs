@@ -58,6 +58,17 @@ impl Grid {
         }
     }
 
+    /// List triangle `t` again with its corners now at `c`: where its box keeps its cells, its
+    /// entries stand as they are (a cell's order is not part of any answer).
+    pub fn update(&mut self, t: u32, c: &[P3; 3]) {
+        let (lo, hi) = bbox(c);
+        if self.of.get(t as usize).copied().flatten() == Some(self.range(lo, hi)) {
+            return;
+        }
+        self.remove(t);
+        self.insert_box(t, lo, hi);
+    }
+
     /// Unlist everything.
     pub fn clear(&mut self) {
         self.cells.clear();

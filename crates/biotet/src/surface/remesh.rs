@@ -592,7 +592,6 @@ impl<'a> Remesher<'a> {
 
     fn replace(&mut self, t: u32, tri: [u32; 3]) {
         self.touch(t);
-        self.grid.remove(t);
         for &v in &self.tris[t as usize] {
             let l = &mut self.vt[v as usize];
             if let Some(p) = l.iter().position(|&x| x == t) {
@@ -605,7 +604,7 @@ impl<'a> Remesher<'a> {
             self.vt[v as usize].push(t);
         }
         let c = self.corners(t);
-        self.grid.insert(t, &c);
+        self.grid.update(t, &c);
     }
 
     fn kill(&mut self, t: u32) {
@@ -740,9 +739,6 @@ impl<'a> Remesher<'a> {
         for (&t, d) in fan.iter().zip(devs) {
             self.dev[t as usize] = d;
         }
-        for &t in &fan {
-            self.grid.remove(t);
-        }
         self.pts[v as usize] = x;
         if let Some(h) = size {
             self.size[v as usize] = h;
@@ -750,7 +746,7 @@ impl<'a> Remesher<'a> {
         for &t in &fan {
             self.touch(t);
             let c = self.corners(t);
-            self.grid.insert(t, &c);
+            self.grid.update(t, &c);
         }
         self.vt[v as usize] = fan;
         self.counts.moves += 1;
