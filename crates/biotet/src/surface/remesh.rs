@@ -354,6 +354,21 @@ impl<'a> Remesher<'a> {
         n
     }
 
+    /// [`Self::neighbours`] in no particular order: a few points, deduplicated by a scan
+    /// rather than a sort.
+    fn neighbour_set(&self, v: u32) -> Vec<u32> {
+        let fan = &self.vt[v as usize];
+        let mut n: Vec<u32> = Vec::with_capacity(2 * fan.len());
+        for &t in fan {
+            for x in self.tris[t as usize] {
+                if x != v && !n.contains(&x) {
+                    n.push(x);
+                }
+            }
+        }
+        n
+    }
+
     fn has_edge(&self, a: u32, b: u32) -> bool {
         self.vt[a as usize]
             .iter()
@@ -868,9 +883,10 @@ impl<'a> Remesher<'a> {
             return None;
         }
         // Link condition: the common neighbours of a and b are c and d alone.
-        let na = self.neighbours(a);
-        let nb = self.neighbours(b);
-        let common = na.iter().filter(|x| nb.binary_search(x).is_ok()).count();
+        // Their neighbours as sets: every use below is a count or an `any`.
+        let na = self.neighbour_set(a);
+        let nb = self.neighbour_set(b);
+        let common = na.iter().filter(|x| nb.contains(x)).count();
         if common != 2 {
             return None;
         }
