@@ -1148,7 +1148,9 @@ impl<'a> Remesher<'a> {
 
     /// The edges of the triangles changed after clock `since` ([`Self::edges`] for 0).
     fn edges_since(&self, since: u64) -> Vec<(u32, u32)> {
-        let mut e: Vec<(u32, u32)> = Vec::with_capacity(self.tris.len() * 3 / 2);
+        // Sorted as one `u64` per edge, `a` in the high half: the order of the pairs, compared
+        // in one step.
+        let mut e: Vec<u64> = Vec::with_capacity(self.tris.len() * 3 / 2);
         for t in 0..self.tris.len() {
             // Every edge is listed by the triangle that has it in increasing order; a changed
             // triangle lists all three of its edges (the one across may not have changed).
@@ -1157,14 +1159,16 @@ impl<'a> Remesher<'a> {
                 for k in 0..3 {
                     let (a, b) = (tri[k], tri[(k + 1) % 3]);
                     if a < b || since > 0 {
-                        e.push((a.min(b), a.max(b)));
+                        e.push((a.min(b) as u64) << 32 | a.max(b) as u64);
                     }
                 }
             }
         }
         e.sort_unstable();
         e.dedup();
-        e
+        e.into_iter()
+            .map(|x| ((x >> 32) as u32, x as u32))
+            .collect()
     }
 
     fn len(&self, a: u32, b: u32) -> f64 {
