@@ -1,6 +1,6 @@
 //! Polish: the last pass over the few unforced tets whose smallest dihedral angle is still below
 //! the threshold after sliver removal and smoothing. Unforced here includes the tets on needles
-//! of 2° or more ([`PolishOptions::needle_deg`]), which the quality report counts as forced: many
+//! of 3° or more ([`PolishOptions::needle_deg`]), which the quality report counts as forced: many
 //! of them have a better apex.
 //!
 //! Sliver removal ([`crate::lastresort::improve()`]) has proved, for each of them, that no refill
@@ -61,9 +61,10 @@ pub struct PolishOptions {
     /// [`Self::forced_deg`]) forces the tets on it here; folds still force below `forced_deg`.
     /// A tet on a needle of a few degrees can have every dihedral angle above the threshold (its
     /// apex in front of the needle's short edge), and polish's points find such apexes for most
-    /// of them: 2° by default (brain_20k 1,365 -> 636 tets under 10°, wm_20k 2,390 -> 1,219, for
-    /// a fifth more CPU time; at 4° 784 and 1,481; below 2° the strip-cut cubes' 1.6° needles
-    /// cost a second of polish and none gets better).
+    /// of them: 3° by default (brain_20k 1,365 -> 699 tets under 10°, wm_20k 2,390 -> 1,353, the
+    /// pipeline 0.99 -> 1.21 s and 1.42 -> 1.83 s; at 2° 636 and 1,219 but wm_20k at 2.0 s, at
+    /// 4° 784 and 1,481; below 2° the strip-cut cubes' 1.6° needles cost a second of polish and
+    /// none gets better).
     pub needle_deg: f64,
     /// Passes over the tets still bad (a pass only revisits tets that changed).
     pub max_rounds: usize,
@@ -97,7 +98,7 @@ impl Default for PolishOptions {
         PolishOptions {
             threshold_deg: 10.0,
             forced_deg: 10.0,
-            needle_deg: 2.0,
+            needle_deg: 3.0,
             max_rounds: 3,
             move_iterations: 8,
             remove: true,

@@ -81,7 +81,7 @@ fn polish_improves_the_tetgen_brain_mesh() {
     let r = polish(&mut m, &PolishOptions::default());
     polish(&mut again, &PolishOptions::default());
     assert!(again == m, "deterministic");
-    // Its own count takes in the report's unforced tets and the ones on needles of 2° to 10°,
+    // Its own count takes in the report's unforced tets and the ones on needles of 3° to 10°,
     // which the report counts as forced.
     assert!(r.n_bad_before > bad0, "{r:?}");
     let bad1 = unforced_bad(&m);
@@ -108,7 +108,7 @@ fn polish_improves_the_tetgen_brain_mesh() {
 }
 
 /// A tet on a needle of a few degrees is not forced to be poor: its apex can sit in front of the
-/// needle's short edge. Polishing TetGen's brain mesh with the needles of 2° to 10° taken as
+/// needle's short edge. Polishing TetGen's brain mesh with the needles of 3° to 10° taken as
 /// unforced (the default) leaves far fewer tets below 10° in all than with every needle under 10°
 /// taken as forcing, no more below 5°, and no more tets the report calls unforced.
 #[test]
