@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
 """Regenerate the shape corpus in tests/data/shapes/: closed triangle surfaces nobody on this project tuned biotet for.
 
-    pip install gmsh==4.15.2 trimesh==5.2.0 shapely numpy scipy    # (pip downloads two wheels for the package meshes, below)
+    pip install gmsh==4.15.2 trimesh==5.2.0 scikit-image==0.26.0 shapely numpy scipy    # (pip downloads two wheels for the package meshes, below)
     python3 scripts/make_shapes.py [--biotet PATH] [--out DIR] [--wheels DIR]
 
-Four sources, one prefix each (the list is SHAPES below; tests/data/shapes/README.md says what each one exercises):
+Five sources, one prefix each (the list is SHAPES below; tests/data/shapes/README.md says what each one exercises):
 
   cad_*   CAD solids built here with the gmsh Python API (OpenCASCADE kernel), or read from the STEP files that ship in
           gmsh's wheel (share/doc/gmsh), surface-meshed by gmsh's default 2D mesher (one thread) at modest sizes, and
@@ -14,6 +14,7 @@ Four sources, one prefix each (the list is SHAPES below; tests/data/shapes/READM
   pkg_*   closed triangle meshes shipped inside Python packages' wheels: gmsh (installed), pyvista and pymeshlab
           (their wheels are fetched with `pip download --no-deps NAME==VERSION` into --wheels, and read from the zip;
           nothing is installed).
+  mc_*    marching-cubes surfaces (scikit-image) of random fields, as segmentations give them.
   gen_*   small awkward cases written out by hand: a lone tetrahedron, Schönhardt's twisted prism, a 1000:1 flat box,
           cubes with grid- and fan-tessellated faces (many coplanar and cocircular points), a cube rotated by an
           irrational angle, a cube with a hole, and two cubes touching along an edge / at a vertex (two shells, one file).
@@ -32,7 +33,7 @@ from benchlib import ROOT, find_biotet  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-PINNED = {"gmsh": "4.15.2", "trimesh": "5.2.0", "pyvista": "0.49.2", "pymeshlab": "2025.7.post1"}
+PINNED = {"gmsh": "4.15.2", "trimesh": "5.2.0", "pyvista": "0.49.2", "pymeshlab": "2025.7.post1", "skimage": "0.26.0"}
 LICENCE = {
     "gmsh": "GPL-2.0-or-later (gmsh distribution file)",
     "pyvista": "MIT (pyvista)",
@@ -566,6 +567,27 @@ def tm_capsule_turned():
     return c.vertices, c.faces
 
 
+def mc_blobs_aniso():
+    """Marching cubes (scikit-image, Lewiner) at 0.3 of a sum of 25 random Gaussian blobs (numpy seed 7, centres in the
+    middle 60% of a 32^3 grid, widths 1.3-4 voxels) on voxels of 1 x 1 x 2.5, as a scanner's slices give them; the
+    largest closed component, coordinates rounded to float32 as an STL export stores them. Organic, needles and caps of
+    marching cubes, and star-shaped from its centroid: recovery's first try leaves 3 triangles, and the cones of
+    biotet::star take back none of the 2,070 interior nodes (18.7 s then, polish on the cones' needles)."""
+    import trimesh
+    from skimage.measure import marching_cubes
+    n = 32
+    rng = np.random.default_rng(7)
+    x, y, z = np.mgrid[0:n, 0:n, 0:n].astype(float)
+    f = np.zeros_like(x)
+    for c in rng.uniform(10 * n / 48, 38 * n / 48, (25, 3)):
+        s = rng.uniform(2 * n / 48, 6 * n / 48)
+        f += np.exp(-((x - c[0]) ** 2 + (y - c[1]) ** 2 + (z - c[2]) ** 2) / (2 * s * s))
+    v, t, _, _ = marching_cubes(np.pad(f, 2), 0.3, spacing=(1.0, 1.0, 2.5))
+    m = trimesh.Trimesh(np.asarray(v, np.float32).astype(float), t, process=True)
+    m = max(m.split(only_watertight=True), key=lambda c: len(c.faces))
+    return m.vertices, m.faces
+
+
 def gen_tetrahedron():
     return np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float), np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
 
@@ -838,6 +860,8 @@ SHAPES = {
     "pkg_pymeshlab_airplane": (pkg("pymeshlab", "sample_meshes/airplane.obj"),
                                "pymeshlab {pymeshlab} wheel: pymeshlab/tests/sample_meshes/airplane.obj",
                                LICENCE["pymeshlab"], "11k triangles, thin wings and tail, sharp edges"),
+    "mc_blobs_aniso": (mc_blobs_aniso, "scikit-image {skimage} marching_cubes of random blobs (seed 7), voxels 1 x 1 x 2.5",
+                       "generated", "marching cubes on anisotropic voxels, star-shaped: cones that take back no node"),
     "gen_tetrahedron": (gen_tetrahedron, "make_shapes.py", "generated", "smallest closed surface: 4 triangles"),
     "gen_schonhardt": (gen_schonhardt, "make_shapes.py", "generated", "Schönhardt prism: no tetrahedralization without a Steiner point"),
     "gen_flat_box": (gen_flat_box, "make_shapes.py", "generated", "1000:1 flat box, 12 triangles"),
@@ -860,6 +884,8 @@ def versions():
     out = {}
     import gmsh, trimesh
     out["gmsh"], out["trimesh"] = gmsh.__version__, trimesh.__version__
+    import skimage
+    out["skimage"] = skimage.__version__
     out["pyvista"], out["pymeshlab"] = PINNED["pyvista"], PINNED["pymeshlab"]  # read from the pinned wheels
     return out
 
@@ -884,7 +910,7 @@ def main():
     if not os.path.exists(biotet):
         sys.exit(f"{biotet} not found: cargo build --release -p biotet-cli, or --biotet PATH")
     ver = versions()
-    for k in ("gmsh", "trimesh"):
+    for k in ("gmsh", "trimesh", "skimage"):
         if ver[k] != PINNED[k]:
             print(f"warning: {k} {ver[k]} installed, the corpus was made with {PINNED[k]}: files may differ",
                   file=sys.stderr)
@@ -923,10 +949,11 @@ def write_readme(path, rows, rejected, ver):
         "`python3 scripts/sweep_shapes.py`. Every file is OFF, coordinates written with Python's `repr` (read back as",
         "the same doubles), exactly equal points welded, and accepted by `biotet validate` when it was made.",
         f"Made with gmsh {ver['gmsh']}, trimesh {ver['trimesh']}, pyvista {ver['pyvista']} (wheel), "
-        f"pymeshlab {ver['pymeshlab']} (wheel).",
+        f"pymeshlab {ver['pymeshlab']} (wheel), scikit-image {ver['skimage']}.",
         "",
         "Prefixes: `cad_` CAD solids (gmsh, OpenCASCADE kernel, default 2D mesher), `tm_` trimesh.creation "
-        "primitives, `pkg_` meshes shipped inside Python packages' wheels, `gen_` small awkward cases made by the script, "
+        "primitives, `pkg_` meshes shipped inside Python packages' wheels, `mc_` marching-cubes surfaces of random fields "
+        "(scikit-image), `gen_` small awkward cases made by the script, "
         "`invalid_` cases `biotet validate` refuses (kept for the refusal message; the benchmark skips them unless asked).",
         "Licences: files marked *generated* are made by the script (MIT OR Apache-2.0, as the project); the others "
         "are derived from the named package's data file under that package's licence.",

@@ -51,6 +51,10 @@ pub struct StarReport {
     pub nodes_left_out: usize,
     /// Triangles recovery had left, all faces now.
     pub triangles_left_by_recovery: usize,
+    /// Whether the mesh is the cones: they are set aside for recovery's other fallbacks when
+    /// they leave out more nodes than they put back, and used only if those leave triangles
+    /// too.
+    pub kept: bool,
 }
 
 /// The regions of `surface` (labels other than 0, in increasing order), each with its boundary

@@ -512,8 +512,12 @@ pub fn run(a: Args) -> Result<ExitCode> {
                 report.seeds
             );
         }
-        let (clearing, inset): (Vec<_>, Vec<_>) =
-            report.retries.iter().partition(|r| r.nodes_added == 0);
+        // Retries that neither removed nor added nodes (wide rounds) change no spacing.
+        let (clearing, inset): (Vec<_>, Vec<_>) = report
+            .retries
+            .iter()
+            .filter(|r| r.nodes_added > 0 || r.nodes_removed > 0)
+            .partition(|r| r.nodes_added == 0);
         if !clearing.is_empty() {
             let removed: usize = clearing.iter().map(|r| r.nodes_removed).sum();
             text += &format!(
@@ -524,7 +528,16 @@ pub fn run(a: Args) -> Result<ExitCode> {
                 report.n_interior_nodes
             );
         }
-        if let Some(s) = &report.star {
+        if let Some(s) = report.star.as_ref().filter(|s| !s.kept) {
+            text += &format!(
+                "recover: {} triangles left; every region is star-shaped, but its cones left out \
+                 {} of {} interior nodes, so recovery's other fallbacks went first\n",
+                s.triangles_left_by_recovery,
+                s.nodes_left_out,
+                s.nodes_inserted + s.nodes_left_out
+            );
+        }
+        if let Some(s) = report.star.as_ref().filter(|s| s.kept) {
             text += &format!(
                 "recover: {} triangles left; every region is star-shaped, so each was coned from \
                  one interior point ({} in all) and the {} interior nodes put back{}\n",

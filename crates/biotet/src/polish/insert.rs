@@ -40,7 +40,7 @@ use super::refill::{
     judge,
 };
 use super::relocate::StepParams;
-use super::work::{Cavity, DEEP_FLAT, DEEP_FLOOR, P3, Rescue, Work};
+use super::work::{Cavity, DEEP_FLAT, DEEP_FLOOR, MAX_STAR, P3, Rescue, Work};
 
 impl Work {
     /// Try to raise `t` (unforced, below `thr` degrees) with one new interior point; the new
@@ -80,7 +80,10 @@ impl Work {
         let tv = self.tets[t as usize];
         let mut edges = Vec::new();
         for v in tv {
-            self.star(v, star);
+            if !self.star_upto(v, star, MAX_STAR) {
+                edges.clear();
+                break;
+            }
             for &s in star.iter() {
                 let shared = self.tets[s as usize]
                     .iter()
@@ -94,7 +97,8 @@ impl Work {
         }
         edges.sort_unstable();
         edges.dedup();
-        if edges != faces
+        if !edges.is_empty()
+            && edges != faces
             && let Some(ids) = self.insert_into(t, edges.clone(), thr, searcher, rp, sp, star, by)
         {
             return Some(ids);
@@ -201,7 +205,9 @@ impl Work {
         let label = self.labels[t as usize];
         let mut tets = Vec::new();
         for v in [tv[ia], tv[ib]] {
-            self.star(v, star);
+            if !self.star_upto(v, star, MAX_STAR) {
+                return None;
+            }
             for &s in star.iter() {
                 if self.labels[s as usize] == label && !self.is_forced(s) {
                     tets.push(s);

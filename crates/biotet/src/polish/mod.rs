@@ -216,8 +216,11 @@ pub fn polish(mesh: &mut TetMesh, opts: &PolishOptions) -> PolishReport {
                 if !opts.remove || w.fixed[v as usize] {
                     continue;
                 }
-                w.star(v, &mut star);
                 report.removals_tried += 1;
+                // A star past the refill's bound is refused by it: not collected whole.
+                if !w.star_upto(v, &mut star, rp.max_tets) {
+                    continue;
+                }
                 let c = Instant::now();
                 let r = w.refill(
                     &mut searcher,

@@ -56,7 +56,10 @@ pub(super) fn run(
             if w.fixed[v as usize] {
                 continue;
             }
-            w.star(v, star);
+            // A star past the refill's bound is refused by it: not collected whole.
+            if !w.star_upto(v, star, PARAMS.max_tets) {
+                continue;
+            }
             if let Some(ids) = w.refill(searcher, star.clone(), Some(v), true, thr, &PARAMS, by) {
                 check.extend(ids);
                 done = true;

@@ -15,7 +15,7 @@ use crate::mesh::tet::{TET_EDGES, TET_FACES};
 use crate::quality::tet::dihedral_at;
 use crate::smooth::ascent::{MAX_ACTIVE, min_norm_point};
 
-use super::work::{P3, Work, angles_upto};
+use super::work::{MAX_STAR, P3, Work, angles_upto};
 
 /// Step parameters of [`Work::relocate`].
 #[derive(Debug, Clone, Copy)]
@@ -53,7 +53,9 @@ impl Work {
         p: &StepParams,
         star: &mut Vec<u32>,
     ) -> bool {
-        self.star(v, star);
+        if !self.star_upto(v, star, MAX_STAR) {
+            return false;
+        }
         let mut members = Vec::with_capacity(star.len());
         for &t in star.iter() {
             let c = self.corners(t);

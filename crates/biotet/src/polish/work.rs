@@ -5,6 +5,7 @@ use crate::mesh::tet::{NO_NEIGHBOR, TET_EDGES, TET_FACES, TetMesh};
 use crate::quality::forced::face_forces;
 use crate::quality::tet::{dihedral_at, dihedral_yx};
 use crate::quality::tri::min_angle_3d_deg;
+use rustc_hash::FxHashSet;
 
 pub(super) type P3 = [f64; 3];
 
@@ -52,6 +53,15 @@ pub enum Rescue {
 
 /// Tets under this fraction of the threshold are flat: [`Rescue::Deep`] takes them.
 pub const DEEP_FLAT: f64 = 1e-3;
+
+/// Lists of tets up to this long are searched by a scan; longer ones through a set.
+const SCAN_LIMIT: usize = 64;
+
+/// Points with more tets than this around them are neither moved nor searched around: a cone's
+/// apex (thousands of tets) was tried once per poor tet at it, each try over its whole star (31 s
+/// of polish on one model), and one point cannot lift that many tets at once. Interior points
+/// have a few dozen.
+pub const MAX_STAR: usize = 512;
 
 /// [`Rescue::Deep`] accepts a fill whose every tet is above this fraction of the threshold.
 pub const DEEP_FLOOR: f64 = 1e-2;
@@ -185,14 +195,18 @@ impl Work {
             .to_degrees()
     }
 
-    /// Every live tet with corner `v`, across the faces around `v` (all labels).
-    pub fn star(&self, v: u32, out: &mut Vec<u32>) {
+    /// Every live tet with corner `v`, across the faces around `v` (all labels), into `out`,
+    /// stopping once it holds more than `limit` tets; whether it is whole.
+    pub fn star_upto(&self, v: u32, out: &mut Vec<u32>, limit: usize) -> bool {
         out.clear();
         let start = self.vtet[v as usize];
         if start == NO_NEIGHBOR {
-            return;
+            return true;
         }
         out.push(start);
+        // A scan of the list while the star is small, a set past that (a cone's apex holds
+        // thousands of tets, and the scans made each star quadratic: 198 s of polish).
+        let mut seen: Option<FxHashSet<u32>> = None;
         let mut i = 0;
         while i < out.len() {
             let t = out[i];
@@ -200,11 +214,25 @@ impl Work {
             let tv = self.tets[t as usize];
             for (k, &n) in self.nb[t as usize].iter().enumerate() {
                 // Faces containing v are those opposite the other corners.
-                if tv[k] != v && n != NO_NEIGHBOR && !out.contains(&n) {
+                if tv[k] == v || n == NO_NEIGHBOR {
+                    continue;
+                }
+                let new = match &mut seen {
+                    Some(set) => set.insert(n),
+                    None => !out.contains(&n),
+                };
+                if new {
                     out.push(n);
+                    if out.len() > limit {
+                        return false;
+                    }
+                    if seen.is_none() && out.len() > SCAN_LIMIT {
+                        seen = Some(out.iter().copied().collect());
+                    }
                 }
             }
         }
+        true
     }
 
     /// Whether the input forces `t` poor: a boundary or interface face with an angle below the
@@ -312,8 +340,12 @@ impl Work {
 
     /// The cavity of `tets` (all of one label).
     pub fn cavity(&self, tets: Vec<u32>) -> Cavity {
-        let (shell, outer) =
-            crate::mesh::cavity::shell(&tets, &self.tets, &self.nb, |n| tets.contains(&n));
+        let (shell, outer) = if tets.len() <= SCAN_LIMIT {
+            crate::mesh::cavity::shell(&tets, &self.tets, &self.nb, |n| tets.contains(&n))
+        } else {
+            let set: FxHashSet<u32> = tets.iter().copied().collect();
+            crate::mesh::cavity::shell(&tets, &self.tets, &self.nb, |n| set.contains(&n))
+        };
         Cavity { tets, shell, outer }
     }
 
@@ -447,6 +479,47 @@ fn widen(p: f64) -> f64 {
 mod tests {
     use super::*;
     use crate::quality::tet::dihedral_angles;
+
+    /// A star is every tet at the point, whether collected by the scan or past
+    /// [`SCAN_LIMIT`] through the set, and one past the limit is reported cut: on an icosphere
+    /// coned from its centre (the apex in all 1,280 tets, a surface point in five or six).
+    #[test]
+    fn stars_are_whole_or_reported_cut() {
+        let s = crate::mesh::surface::SurfaceMesh::icosphere(1.0, 3);
+        let k = crate::star::kernels(&s).expect("a sphere is star-shaped");
+        let ns = s.points.len();
+        let (mut mesh, _) = crate::star::coned(&s, &k, &s.points, &[], ns);
+        let n = mesh.tets.len();
+        assert_eq!(n, s.triangles.len());
+        let w = Work::new(&mut mesh, 10.0, 3.0);
+        let apex = ns as u32;
+        let mut out = Vec::new();
+        let cases = [
+            (apex, usize::MAX),
+            (apex, n),
+            (apex, 100),
+            (apex, 10),
+            (0, usize::MAX),
+            (0, 4),
+        ];
+        for (v, limit) in cases {
+            let whole = w.star_upto(v, &mut out, limit);
+            let mut all: Vec<u32> = (0..n as u32)
+                .filter(|&t| w.tets[t as usize].contains(&v))
+                .collect();
+            let mut got = out.clone();
+            got.sort_unstable();
+            assert_eq!(whole, all.len() <= limit, "point {v}, limit {limit}");
+            if whole {
+                assert_eq!(got, all, "point {v}");
+            } else {
+                assert_eq!(got.len(), limit + 1);
+                all.retain(|t| got.binary_search(t).is_ok());
+                assert_eq!(all.len(), got.len(), "point {v}: a tet not at it");
+            }
+        }
+        assert!(!w.star_upto(apex, &mut out, MAX_STAR));
+    }
 
     /// The screened measures are those of `dihedral_angles` bit for bit, on regular, flat,
     /// needle, sliver and random tets (ties between equal angles included).
