@@ -112,12 +112,14 @@ impl Default for PolishOptions {
     }
 }
 
-/// What [`polish`] did.
+/// What [`polish`] did. Its counts of tets below the threshold are polish's own: the tets it
+/// works on, which take in those on a needle between [`PolishOptions::needle_deg`] and the
+/// threshold (the report's forcing counts them as forced).
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct PolishReport {
-    /// Unforced tets below the threshold before.
+    /// Unforced tets (polish's sense, above) below the threshold before.
     pub n_bad_before: usize,
-    /// Unforced tets below the threshold after.
+    /// Unforced tets (polish's sense) below the threshold after.
     pub n_bad_after: usize,
     /// Point moves tried.
     pub moves_tried: usize,
