@@ -109,6 +109,30 @@ def write_off(path, points, tris):
         f.writelines(f"3 {a} {b} {c}\n" for a, b, c in tris)
 
 
+def write_random(exe, out, count, make, what):
+    """Write up to `count` random surfaces to `out` for the robustness scripts (random_cad.py, random_fields.py):
+    `make(k)` gives the k-th try's (name, (points, triangles) or None); each is written as OFF and kept only if
+    `biotet validate` (the binary `exe`) accepts it, at most ten tries a surface."""
+    os.makedirs(out, exist_ok=True)
+    written = tried = 0
+    while written < count and tried < 10 * count:
+        name, got = make(tried)
+        tried += 1
+        if got is None:
+            continue
+        path = os.path.join(out, name + ".off")
+        write_off(path, *got)
+        r = subprocess.run([exe, "validate", path], capture_output=True, text=True)
+        if r.returncode != 0:
+            why = (r.stderr or r.stdout).strip().splitlines()[-1]
+            print(f"{name}: refused by validate: {why[:160]}")
+            os.remove(path)
+            continue
+        written += 1
+        print(f"{name}: {len(got[1])} triangles")
+    print(f"{written} {what} written to {out} ({tried} tried)")
+
+
 # ---------------------------------------------------------------------------------------------------------------------
 # readers for the package meshes (plain text parsed with Python's float: exact doubles of the decimals written)
 

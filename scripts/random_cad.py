@@ -13,11 +13,11 @@ leaves more or fewer than one volume is dropped, and so is any surface `biotet v
 as DIR/occ_SEED_K.off. The same seed gives the same files with the pinned gmsh. Nothing here is tuned: the point is
 shapes the corpus lacks (saddles, slivers of cut solids, coarse facets on curved faces).
 """
-import argparse, os, random, subprocess, sys
+import argparse, os, random, sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from benchlib import find_biotet  # noqa: E402
-from make_shapes import Gmsh, write_off  # noqa: E402
+from make_shapes import Gmsh, write_random  # noqa: E402
 
 
 def primitive(occ, rng):
@@ -77,27 +77,14 @@ def main():
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--biotet", help="biotet binary for `validate` (default: the release build)")
     a = ap.parse_args()
-    exe = find_biotet(a.biotet)
-    os.makedirs(a.out, exist_ok=True)
     rng = random.Random(a.seed)
-    written = tried = 0
-    while written < a.count and tried < 10 * a.count:
-        name = f"occ_{a.seed}_{tried}"
-        tried += 1
+
+    def make(k):
+        name = f"occ_{a.seed}_{k}"
         got = solid(name, rng)
-        if got is None or len(got[1]) > 40000:
-            continue
-        path = os.path.join(a.out, name + ".off")
-        write_off(path, *got)
-        r = subprocess.run([exe, "validate", path], capture_output=True, text=True)
-        if r.returncode != 0:
-            why = (r.stderr or r.stdout).strip().splitlines()[-1]
-            print(f"{name}: refused by validate: {why[:160]}")
-            os.remove(path)
-            continue
-        written += 1
-        print(f"{name}: {len(got[1])} triangles")
-    print(f"{written} solids written to {a.out} ({tried} tried)")
+        return name, None if got is None or len(got[1]) > 40000 else got
+
+    write_random(find_biotet(a.biotet), a.out, a.count, make, "solids")
 
 
 if __name__ == "__main__":

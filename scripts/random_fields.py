@@ -19,11 +19,11 @@ refuses; the rest are written as DIR/field_SEED_K_KIND.off. The same seed gives 
 packages. Nothing here is tuned: a union of blobs on voxels of 1 x 1 x 2.5 found by this script took 19 s (the cones
 of a star-shaped region that took back none of the nodes) before session 39, and is in the corpus as mc_blobs_aniso.
 """
-import argparse, os, subprocess, sys
+import argparse, os, sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from benchlib import find_biotet  # noqa: E402
-from make_shapes import write_off  # noqa: E402
+from make_shapes import write_random  # noqa: E402
 
 import numpy as np  # noqa: E402
 
@@ -81,28 +81,13 @@ def main():
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--biotet", help="biotet binary for `validate` (default: the release build)")
     a = ap.parse_args()
-    exe = find_biotet(a.biotet)
-    os.makedirs(a.out, exist_ok=True)
     rng = np.random.default_rng(a.seed)
-    written = tried = 0
-    while written < a.count and tried < 10 * a.count:
-        kind = KINDS[tried % len(KINDS)]
-        name = f"field_{a.seed}_{tried}_{kind}"
-        tried += 1
-        got = surface(kind, rng)
-        if got is None:
-            continue
-        path = os.path.join(a.out, name + ".off")
-        write_off(path, *got)
-        r = subprocess.run([exe, "validate", path], capture_output=True, text=True)
-        if r.returncode != 0:
-            why = (r.stderr or r.stdout).strip().splitlines()[-1]
-            print(f"{name}: refused by validate: {why[:160]}")
-            os.remove(path)
-            continue
-        written += 1
-        print(f"{name}: {len(got[1])} triangles")
-    print(f"{written} surfaces written to {a.out} ({tried} tried)")
+
+    def make(k):
+        kind = KINDS[k % len(KINDS)]
+        return f"field_{a.seed}_{k}_{kind}", surface(kind, rng)
+
+    write_random(find_biotet(a.biotet), a.out, a.count, make, "surfaces")
 
 
 if __name__ == "__main__":
