@@ -112,6 +112,12 @@ impl Default for PolishOptions {
     }
 }
 
+/// A point with more tets around it than this is not removed: no fill of so large a star
+/// without it was ever kept (none of 77 tries over 80 tets on the brain models, the corpus and
+/// marching-cubes surfaces of random fields, against 62 of 5,300 from 40 to 80), and each try
+/// costs milliseconds (a revolved zigzag's polish 0.33 → 0.26 s, the same mesh).
+const REMOVE_MAX_STAR: usize = 80;
+
 /// What [`polish`] did. Its counts of tets below the threshold are polish's own: the tets it
 /// works on, which take in those on a needle between [`PolishOptions::needle_deg`] and the
 /// threshold (the report's forcing counts them as forced).
@@ -219,8 +225,7 @@ pub fn polish(mesh: &mut TetMesh, opts: &PolishOptions) -> PolishReport {
                     continue;
                 }
                 report.removals_tried += 1;
-                // A star past the refill's bound is refused by it: not collected whole.
-                if !w.star_upto(v, &mut star, rp.max_tets) {
+                if !w.star_upto(v, &mut star, REMOVE_MAX_STAR) {
                     continue;
                 }
                 let c = Instant::now();
