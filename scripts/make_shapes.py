@@ -109,6 +109,16 @@ def write_off(path, points, tris):
         f.writelines(f"3 {a} {b} {c}\n" for a, b, c in tris)
 
 
+def random_args(doc, count, what):
+    """The command line the robustness scripts share: --out, --count (default `count`), --seed, --biotet."""
+    ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
+    ap.add_argument("--out", required=True, help="directory for the OFF files")
+    ap.add_argument("--count", type=int, default=count, help=f"{what} to write (default {count})")
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--biotet", help="biotet binary for `validate` (default: the release build)")
+    return ap.parse_args()
+
+
 def write_random(exe, out, count, make, what):
     """Write up to `count` random surfaces to `out` for the robustness scripts (random_cad.py, random_fields.py):
     `make(k)` gives the k-th try's (name, (points, triangles) or None); each is written as OFF and kept only if

@@ -13,11 +13,11 @@ leaves more or fewer than one volume is dropped, and so is any surface `biotet v
 as DIR/occ_SEED_K.off. The same seed gives the same files with the pinned gmsh. Nothing here is tuned: the point is
 shapes the corpus lacks (saddles, slivers of cut solids, coarse facets on curved faces).
 """
-import argparse, os, random, sys
+import os, random, sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from benchlib import find_biotet  # noqa: E402
-from make_shapes import Gmsh, write_random  # noqa: E402
+from make_shapes import Gmsh, random_args, write_random  # noqa: E402
 
 
 def primitive(occ, rng):
@@ -71,12 +71,7 @@ def solid(name, rng):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--out", required=True, help="directory for the OFF files")
-    ap.add_argument("--count", type=int, default=60, help="solids to write (default 60)")
-    ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--biotet", help="biotet binary for `validate` (default: the release build)")
-    a = ap.parse_args()
+    a = random_args(__doc__, 60, "solids")
     rng = random.Random(a.seed)
 
     def make(k):

@@ -19,11 +19,11 @@ refuses; the rest are written as DIR/field_SEED_K_KIND.off. The same seed gives 
 packages. Nothing here is tuned: a union of blobs on voxels of 1 x 1 x 2.5 found by this script took 19 s (the cones
 of a star-shaped region that took back none of the nodes) before session 39, and is in the corpus as mc_blobs_aniso.
 """
-import argparse, os, sys
+import os, sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from benchlib import find_biotet  # noqa: E402
-from make_shapes import write_random  # noqa: E402
+from make_shapes import random_args, write_random  # noqa: E402
 
 import numpy as np  # noqa: E402
 
@@ -75,12 +75,7 @@ def surface(kind, rng):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--out", required=True, help="directory for the OFF files")
-    ap.add_argument("--count", type=int, default=30, help="surfaces to write (default 30)")
-    ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--biotet", help="biotet binary for `validate` (default: the release build)")
-    a = ap.parse_args()
+    a = random_args(__doc__, 30, "surfaces")
     rng = np.random.default_rng(a.seed)
 
     def make(k):

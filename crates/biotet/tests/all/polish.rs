@@ -16,6 +16,18 @@ fn min_deg(m: &TetMesh, t: usize) -> f64 {
         .to_degrees()
 }
 
+/// Tets whose smallest dihedral angle is below `deg` degrees.
+fn tets_below(m: &TetMesh, deg: f64) -> usize {
+    (0..m.tets.len()).filter(|&t| min_deg(m, t) < deg).count()
+}
+
+/// A copy of `base` polished with `opts`, with polish's report.
+fn polished(base: &TetMesh, opts: &PolishOptions) -> (TetMesh, biotet::polish::PolishReport) {
+    let mut m = base.clone();
+    let r = polish(&mut m, opts);
+    (m, r)
+}
+
 fn assert_all_positive(m: &TetMesh) {
     for t in 0..m.tets.len() {
         let c = m.corners(t);
@@ -115,17 +127,16 @@ fn polish_improves_the_tetgen_brain_mesh() {
 fn polish_finds_better_apexes_over_needles() {
     let base = tetgen_brain();
     let surface = load_stl("brain_20k.stl");
-    let below = |m: &TetMesh, deg: f64| (0..m.tets.len()).filter(|&t| min_deg(m, t) < deg).count();
+    let below = tets_below;
     let run = |needle_deg: f64| {
-        let mut m = base.clone();
-        polish(
-            &mut m,
+        polished(
+            &base,
             &PolishOptions {
                 needle_deg,
                 ..PolishOptions::default()
             },
-        );
-        m
+        )
+        .0
     };
     let (old, new) = (run(10.0), run(PolishOptions::default().needle_deg));
     let unforced = |m: &TetMesh| summarise(m, &classify(m, &surface, 10.0), 10.0);
@@ -238,19 +249,17 @@ fn polish_inserts_a_point_into_a_sliver_with_four_surface_corners() {
 fn polish_fixes_wedges_at_short_edges_of_the_tetgen_brain_mesh() {
     let base = tetgen_brain();
     let surface = load_stl("brain_20k.stl");
-    let below = |m: &TetMesh, deg: f64| (0..m.tets.len()).filter(|&t| min_deg(m, t) < deg).count();
+    let below = tets_below;
     let run = |wedge: bool| {
-        let mut m = base.clone();
-        let r = polish(
-            &mut m,
+        polished(
+            &base,
             &PolishOptions {
                 wedge,
                 // Every needle forcing: the comparison sees the wedge step alone.
                 needle_deg: 10.0,
                 ..PolishOptions::default()
             },
-        );
-        (m, r)
+        )
     };
     let (off, r0) = run(false);
     let (on, r1) = run(true);
@@ -287,7 +296,7 @@ fn polish_refills_tets_above_165_degrees() {
             })
             .count()
     };
-    let below = |m: &TetMesh| (0..m.tets.len()).filter(|&t| min_deg(m, t) < 10.0).count();
+    let below = |m: &TetMesh| tets_below(m, 10.0);
     let mut off = tetgen_brain();
     let r_off = polish(
         &mut off,
@@ -400,7 +409,7 @@ fn polish_at_least_halves_the_tets_under_10_degrees_of_a_square_section_ring_tub
     let mut s = crate::common::load_shape("tm_square_torus.off");
     validate_surface(&mut s, &ValidateOptions::default()).unwrap();
     let sizing = crate::common::default_sizing(&s);
-    let bad = |m: &TetMesh| (0..m.tets.len()).filter(|&t| min_deg(m, t) < 10.0).count();
+    let bad = |m: &TetMesh| tets_below(m, 10.0);
     let defaults = PipelineOptions::default();
     // Without the seeds, which put TetGen's points in the segments before polish runs
     // (tests/all/seeds.rs).
