@@ -325,17 +325,71 @@ pub fn one_sided(
     flag: f64,
     floor: f64,
 ) -> Sided {
-    struct Per {
-        max: f64,
-        bound: f64,
-        far: Option<Far>,
-        n: usize,
-    }
+    let s = Sampling {
+        spacing,
+        fine,
+        limit,
+        flag,
+        floor,
+    };
+    one_sided_reusing((pts, tris, sides, alive), to, &s, |_| None).0
+}
+
+/// How [`one_sided`] samples (its arguments of the same names).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sampling {
+    /// Grid step at most this.
+    pub spacing: f64,
+    /// Cells split down to about this.
+    pub fine: f64,
+    /// The distance to prove.
+    pub limit: f64,
+    /// Triangles farther than this are listed.
+    pub flag: f64,
+    /// Samples proven no farther than this are not measured.
+    pub floor: f64,
+}
+
+/// Triangles as points, corners, side labels and (optionally) which of them are in.
+pub type Triangles<'s> = (&'s [P3], &'s [[u32; 3]], &'s [[u32; 2]], Option<&'s [bool]>);
+
+/// One triangle's measure ([`one_sided_reusing`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Per {
+    /// Its largest sampled distance.
+    pub max: f64,
+    /// An upper bound on its distance.
+    pub bound: f64,
+    /// Its farthest sample, when listed in [`Sided::far`].
+    pub far: Option<Far>,
+    /// Its samples.
+    pub n: usize,
+}
+
+/// [`one_sided`], with each triangle's measure taken from `reuse(t)` where it gives one (a
+/// measure of the same triangle against the same neighbourhood, kept from before), and the
+/// measures of all triangles returned to be kept.
+pub fn one_sided_reusing(
+    (pts, tris, sides, alive): Triangles<'_>,
+    to: &PatchIndex,
+    s: &Sampling,
+    reuse: impl Fn(usize) -> Option<Per> + Sync,
+) -> (Sided, Vec<Per>) {
+    let Sampling {
+        spacing,
+        fine,
+        limit,
+        flag,
+        floor,
+    } = *s;
     // Per grid point, row by row: an upper bound on its distance and the other surface's
     // triangle (slot) within it, if one was found (one buffer a job, not one a triangle).
     let per: Vec<Per> = (0..tris.len())
         .into_par_iter()
         .map_init(Vec::new, |grid: &mut Vec<(f64, u32)>, t| {
+            if let Some(p) = reuse(t) {
+                return p;
+            }
             if alive.is_some_and(|a| !a[t]) {
                 return Per {
                     max: 0.0,
@@ -432,7 +486,7 @@ pub fn one_sided(
         }
     }
     out.per_sheet = per_sheet;
-    out
+    (out, per)
 }
 
 #[cfg(test)]
