@@ -1535,6 +1535,57 @@ pub(super) mod tests {
         }
     }
 
+    /// A repair can bring closer a surface the rounds left between 0.8 D (the clean-up's
+    /// working tolerance) and D: on a sphere pushed out by 0.85 D, a point split into a triangle
+    /// goes onto the input at the repairs' working tolerance, and not at the clean-up's (every
+    /// new triangle there has samples beyond it, so every move was refused).
+    #[test]
+    fn repairs_move_a_surface_between_the_working_tolerance_and_d() {
+        let input = uv_sphere(1.0, [0.0; 3], 24, 10);
+        let (d, l) = (0.02, median_edge_length(&input));
+        let fx = Fixture::new(&input, d, l);
+        let mut out = input.clone();
+        for p in &mut out.points {
+            *p = p.map(|x| x * (1.0 + 0.85 * d));
+        }
+        // Each input sample covered by its own triangle pushed out.
+        let cover: Vec<(u32, f64)> = (fx.samples.pts.iter().zip(&fx.samples.tri))
+            .map(|(&p, &t)| {
+                let c = out.corners(t as usize);
+                (t, dist2(p, closest_on_triangle(p, &c)).sqrt())
+            })
+            .collect();
+        assert!(cover.iter().all(|x| x.1 > 0.8 * d && x.1 < d));
+        // A triangle of the middle band and the input point nearest its centroid.
+        let t = (0..out.triangles.len() as u32)
+            .find(|&t| out.corners(t as usize).iter().all(|c| c[2].abs() < 0.5))
+            .expect("a band triangle");
+        let c = out.corners(t as usize);
+        let g = [0, 1, 2].map(|k| (c[0][k] + c[1][k] + c[2][k]) / 3.0);
+        let q = (fx.index.get(input.sides[0]))
+            .and_then(|b| b.closest(g))
+            .expect("input")
+            .point;
+        let repaired = |tol: f64| {
+            let mut r = Remesher::new(
+                &out,
+                &fx.f,
+                &fx.index,
+                &fx.samples,
+                Some(&cover),
+                &fx.size,
+                &fx.tri_size,
+                l,
+                tol,
+            );
+            r.repairing = true;
+            let mi = r.pts.len();
+            r.refine_toward(t, q) && r.pts.get(mi) == Some(&q)
+        };
+        assert!(repaired(super::super::REPAIR_TOL * d));
+        assert!(!repaired(0.8 * d));
+    }
+
     /// The distance bounds the loop keeps instead of recomputing are true bounds: after rounds
     /// of every operation on a needle sphere, every input sample is within the tolerance of the
     /// triangle that covers it (by brute force, no farther than its bound), and every
