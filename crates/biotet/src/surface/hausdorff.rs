@@ -251,7 +251,7 @@ pub struct Sided {
     /// The farthest sample of each triangle farther than the flag distance or whose bound stays
     /// over the limit.
     pub far: Vec<Far>,
-    /// Number of samples measured.
+    /// Number of samples measured (with [`one_sided_reusing`], those behind the measures kept too).
     pub n_samples: usize,
 }
 
