@@ -15,7 +15,7 @@
 //! triangles come closer than before, they are upper bounds still.
 
 use rayon::prelude::*;
-use rustc_hash::FxHashMap;
+use rustc_hash::{FxHashMap, FxHashSet};
 
 use super::bvh::PatchIndex;
 use super::grid::Grid;
@@ -166,7 +166,7 @@ impl<'a> Measure<'a> {
                 n += 1;
             }
         }
-        let now: rustc_hash::FxHashSet<&Key> = keys.iter().collect();
+        let now: FxHashSet<&Key> = keys.iter().collect();
         for (key, (_, (lo, hi))) in &k.oi {
             if !now.contains(key) {
                 changed.insert_box(n, *lo, *hi);

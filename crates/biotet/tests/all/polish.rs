@@ -127,7 +127,6 @@ fn polish_improves_the_tetgen_brain_mesh() {
 fn polish_finds_better_apexes_over_needles() {
     let base = tetgen_brain();
     let surface = load_stl("brain_20k.stl");
-    let below = tets_below;
     let run = |needle_deg: f64| {
         polished(
             &base,
@@ -142,12 +141,12 @@ fn polish_finds_better_apexes_over_needles() {
     let unforced = |m: &TetMesh| summarise(m, &classify(m, &surface, 10.0), 10.0);
     let (uo, un) = (unforced(&old), unforced(&new));
     assert!(
-        10 * below(&new, 10.0) < 8 * below(&old, 10.0),
+        10 * tets_below(&new, 10.0) < 8 * tets_below(&old, 10.0),
         "{} vs {}",
-        below(&new, 10.0),
-        below(&old, 10.0)
+        tets_below(&new, 10.0),
+        tets_below(&old, 10.0)
     );
-    assert!(below(&new, 5.0) <= below(&old, 5.0));
+    assert!(tets_below(&new, 5.0) <= tets_below(&old, 5.0));
     assert!(un.n_unforced_dihedral_lt_10 <= uo.n_unforced_dihedral_lt_10);
     assert_all_positive(&new);
     let c = check(&new, Some(&surface));
@@ -249,7 +248,6 @@ fn polish_inserts_a_point_into_a_sliver_with_four_surface_corners() {
 fn polish_fixes_wedges_at_short_edges_of_the_tetgen_brain_mesh() {
     let base = tetgen_brain();
     let surface = load_stl("brain_20k.stl");
-    let below = tets_below;
     let run = |wedge: bool| {
         polished(
             &base,
@@ -271,8 +269,8 @@ fn polish_fixes_wedges_at_short_edges_of_the_tetgen_brain_mesh() {
         summarise(&on, &f, 10.0).n_unforced_dihedral_lt_10,
         r1.n_bad_after
     );
-    assert!(below(&on, 10.0) <= below(&off, 10.0));
-    assert!(below(&on, 5.0) <= below(&off, 5.0));
+    assert!(tets_below(&on, 10.0) <= tets_below(&off, 10.0));
+    assert!(tets_below(&on, 5.0) <= tets_below(&off, 5.0));
     assert!(on.points.len() > off.points.len(), "points added");
     assert_all_positive(&on);
     let c = check(&on, Some(&surface));
