@@ -13,7 +13,7 @@
 //! appended data, inline base64 (optionally compressed) and ASCII. Points are `Float64` (exact),
 //! connectivity and offsets `Int32` (`Int64` when needed), cell types `UInt8` (10 = tetra).
 //! Cell data: `region` (`Int32`, the label; marked as the active scalars), and per tet, from
-//! [`TetMeasures`]: `min_dihedral_deg`, `min_solid_angle_sr` and `q` (`Float64`).
+//! [`TetMeasures`](biotet::quality::tet::TetMeasures): `min_dihedral_deg`, `min_solid_angle_sr` and `q` (`Float64`).
 //!
 //! Reading: `UnstructuredGrid` files with any number of pieces; data arrays in `ascii`, inline
 //! `binary` (base64) or `appended` (`raw` or `base64`) format, optionally compressed with

@@ -11,7 +11,7 @@
 //! region (with the poor tets beside them when that passes, else alone: a flat tet on a planar quad
 //! has no circumsphere to hold it), form a cavity whose every shell face sees it strictly inside
 //! (exact `orient3d`), with no point lost, and whose cone's worst dihedral angle is above
-//! [`SEED_BELOW_DEG`] (half of it where the cavity holds a flat tet, under [`FLAT_DEG`]) and above
+//! [`SEED_BELOW_DEG`] (half of it where the cavity holds a flat tet, under `FLAT_DEG`) and above
 //! the cavity's worst. Cavities of two seeds never share a tet; every accepted cone replaces its
 //! cavity at once. Boundary and interface faces are never crossed, so they stay faces.
 //!

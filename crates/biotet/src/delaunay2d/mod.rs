@@ -4,7 +4,7 @@
 //!
 //! The structure is the 3D one cut down by a dimension:
 //! - **Order.** Points are sorted along a 2D Hilbert curve and dealt into BRIO rounds
-//!   ([`crate::delaunay::order::brio`], the same rounds and seed rule as in 3D), so each walk is
+//!   (`delaunay::order::brio`, the same rounds and seed rule as in 3D), so each walk is
 //!   short and the expected work is linear.
 //! - **Infinite vertex.** Every hull edge `ab` carries a ghost triangle `(a, b, ∞)`, so points
 //!   outside the hull need no special case. A ghost conflicts with a point `p` strictly outside

@@ -48,14 +48,14 @@
 //! Some shells have no tetrahedralization without new points (the Schönhardt polyhedron, a
 //! cube whose face diagonals twist). Recovery stays total on valid input:
 //! - surface points the mesh lacks (or holds in no tet) are put back before anything else, by
-//!   splitting the tets that hold them ([`kernel::split_insert`](super::kernel)) or, outside
+//!   splitting the tets that hold them (`kernel::split_insert`) or, outside
 //!   the mesh, by growing its convex hull to them;
 //! - the no-new-point queue is bounded by work: [`RecoverOptions::max_tries`] attempts a
 //!   triangle, [`RecoverOptions::max_grow`] rings, [`RecoverOptions::max_cavity_tets`] tets
 //!   and the search's node budget, so no triangle costs seconds;
 //! - with [`RecoverOptions::allow_interior_steiner`] (the default) the triangles left are tried
 //!   again, smallest cavities first; a cell with no fill of its own points gets one point
-//!   strictly inside its kernel (exact check, [`super::kernel`]): the fill through it the search
+//!   strictly inside its kernel (exact check, the `kernel` module): the fill through it the search
 //!   finds, or the cone from it. The point is strictly inside a cell, so never on the surface
 //!   (checked exactly against every surface triangle too). This alternates with the
 //!   no-new-point queue while either makes progress;
@@ -143,7 +143,7 @@ pub struct RecoverOptions {
     /// tets), then with [`SearchOptions::min_quality`] if that fails; at or below it, one search.
     pub first_quality: f64,
     /// After a Steiner round without progress, carve wider cavities and search longer (see
-    /// [`WIDE_GROW`]). The pipeline's first try goes without: it clears the nodes around what
+    /// `WIDE_GROW`). The pipeline's first try goes without: it clears the nodes around what
     /// is left and tries again instead, which costs milliseconds where wide cavities of a
     /// triangle far larger than the spacing cost seconds.
     pub widen: bool,

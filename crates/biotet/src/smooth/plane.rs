@@ -17,7 +17,7 @@
 //! (two boundary edges at an angle, or more than two) stay.
 //!
 //! A sweep visits the movable nodes worst cluster first, in colour classes of nodes that share no
-//! triangle (the greedy colouring of the 3D smoothing, [`super::colour`]): each class is optimised
+//! triangle (the greedy colouring of the 3D smoothing, `smooth::colour`): each class is optimised
 //! in parallel from the positions before it and applied after, Gauss–Seidel between classes.
 //!
 //! Guarantees: only coordinates change; the smallest angle of the mesh never decreases (every

@@ -26,7 +26,7 @@ const GRID_STEPS: usize = 64;
 
 impl InputSamples {
     /// Sample `s` with step at most `spacing` on each triangle: a barycentric grid with that
-    /// step along the longest edge, or, on a triangle more than [`GRID_STEPS`] steps long, rows
+    /// step along the longest edge, or, on a triangle more than `GRID_STEPS` steps long, rows
     /// parallel to its longest edge, `spacing` apart. The grid's samples grow with the square of
     /// the longest edge however thin the triangle: a needle 200 long and 0.4 wide at spacing 0.25
     /// held 320,000, its rows 1,200.

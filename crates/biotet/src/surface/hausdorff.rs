@@ -10,7 +10,7 @@
 //! largest distance of its three corners to one triangle of the other surface (one found at a
 //! corner): the distance to one triangle is convex, so over the cell it is largest at a corner,
 //! and the cell is proven without finer samples (on the brain models, a third of the samples).
-//! A cell neither proves is sampled finer on its own, recursively ([`Probe::cell`]), so the
+//! A cell neither proves is sampled finer on its own, recursively (`Probe::cell`), so the
 //! samples gather where the distance comes near the limit. The largest bound over all cells is
 //! [`Sided::bound`].
 //!
@@ -306,7 +306,7 @@ const SPLIT_SAMPLES: usize = 64;
 /// The one-sided distance from the triangles `tris` over `pts` (those with `alive[t]`, when
 /// given) to `to`, on a grid of step at most `spacing`. Where a grid cell's bound (its sampled
 /// maximum plus covering radius, or its corners' distance to one triangle) exceeds `limit`, the
-/// cell is split, down to cells of about `fine` ([`Probe::cell`]; pass `limit = f64::INFINITY`
+/// cell is split, down to cells of about `fine` (`Probe::cell`; pass `limit = f64::INFINITY`
 /// for the grid alone). Triangles farther than `flag`, or whose bound stays over `limit`, are listed in
 /// [`Sided::far`] (their farthest sample). Samples proven (by the Lipschitz bound
 /// from the previous sample of their row) no farther than `floor` or than the maximum so far are

@@ -45,7 +45,7 @@ pub const BALL_MAX_SIZES: f64 = 3.0;
 
 /// A boundary triangle whose circumradius is above [`BALL_MAX_SIZES`] sizes but at most this
 /// many has the inner cap of a larger sphere through its corners cleared instead of its ball
-/// (see [`cap_height`]).
+/// (see `cap_height`).
 pub const CAP_MAX_SIZES: f64 = 32.0;
 
 /// Triangles per wave of [`seal_triangles`], and per parallel piece of a wave: bounded memory
