@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
-# Every test: the Rust workspace (cargo test), a smoke run of every fuzz target, then the Python
-# package built from crates/biotet-py into a virtual environment under target/ and its pytest
-# suite (which compares with the CLI binary cargo test just built).
+# Every test: the Rust workspace (cargo test), the API docs (cargo doc, a warning fails), a smoke
+# run of every fuzz target, then the Python package built from crates/biotet-py into a virtual
+# environment under target/ and its pytest suite (which compares with the CLI binary cargo test
+# just built).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo test --workspace --locked
+# The API docs build without a warning (a broken or private link fails here).
+RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --locked
 # Every fuzz target for a few seconds (libFuzzer on stable; seeds, then mutations): a smoke run,
 # the long runs are scripts/fuzz.sh's. BIOTET_FUZZ_SECONDS=0 skips it.
 if [ "${BIOTET_FUZZ_SECONDS:-3}" != 0 ]; then
