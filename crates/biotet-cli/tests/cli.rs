@@ -240,7 +240,6 @@ fn bad_surfaces_get_a_clear_error() {
     let hole = cube_off(|t, _| {
         t.pop();
     });
-    let flipped = cube_off(|t, _| t[3].swap(1, 2));
     // A second cube poking through the first one's face x = 1.
     let crossing = cube_off(|t, p| {
         let o = p.len();
@@ -256,10 +255,10 @@ fn bad_surfaces_get_a_clear_error() {
         t.extend(first.iter().map(|f| f.map(|v| v + o)));
     });
     // (Two cubes sharing only an edge are valid: two regions, see
-    // shells_touching_along_an_edge_or_at_a_vertex_are_two_regions.)
+    // shells_touching_along_an_edge_or_at_a_vertex_are_two_regions; a triangle turned against
+    // its neighbours is turned back, see inward_surface_is_flipped_and_the_user_told.)
     for (name, text, words) in [
         ("hole.off", hole, &["hole.off", "closed"][..]),
-        ("flipped.off", flipped, &["flipped.off", "orient"][..]),
         ("crossing.off", crossing, &["crossing.off", "intersect"][..]),
     ] {
         let (out, _, _d) = validate_text(name, &text);
@@ -290,6 +289,28 @@ fn inward_surface_is_flipped_and_the_user_told() {
     let (out, _, _d) = validate_text("inward.off", &inward);
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(stderr(&out).contains("flipped"), "{}", stderr(&out));
+    // One triangle, then half of them, turned against their neighbours (the orientation means
+    // nothing before the nesting gives the regions): the minority turned back, the user told,
+    // and the cube meshes with every triangle kept.
+    for (name, turned, n) in [
+        ("one.off", &[3usize][..], 1),
+        ("half.off", &[0, 2, 4, 6, 8, 10], 6),
+    ] {
+        let text = cube_off(|t, _| {
+            for &k in turned {
+                t[k].swap(1, 2);
+            }
+        });
+        let (out, p, d) = validate_text(name, &text);
+        assert!(out.status.success(), "{name}: {}", stderr(&out));
+        let want = format!("{n} of the 12 triangles of shell 0 were turned");
+        assert!(stderr(&out).contains(&want), "{name}: {}", stderr(&out));
+        let o = d.path().join("out.vtu");
+        let m = biotet(&["mesh", s(&p), "-o", s(&o), "-q"]);
+        assert!(m.status.success(), "{name}: {}", stderr(&m));
+        let c = biotet(&["check", s(&o), "--surface", s(&p), "-q"]);
+        assert!(c.status.success(), "{name}: {}", stderr(&c));
+    }
 }
 
 #[test]

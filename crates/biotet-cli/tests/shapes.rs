@@ -453,3 +453,41 @@ fn triangles_far_larger_than_the_size_get_a_note_and_a_remedy() {
     let c = biotet(&["check", out, "-q"]);
     assert!(c.status.success(), "{}", String::from_utf8_lossy(&c.stdout));
 }
+
+#[test]
+fn a_triangle_soup_meshes_as_its_welded_surface() {
+    // Each triangle on three points of its own, as a PLY or OBJ written without merging points
+    // (trimesh's export of an STL it did not process): one shell, not one per triangle.
+    let dir = tempfile::tempdir().unwrap();
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/shapes/tm_capsule.off");
+    let s = biotet_io::read_surface(&src).unwrap().mesh;
+    let mut soup = biotet::SurfaceMesh {
+        points: Vec::new(),
+        triangles: Vec::new(),
+        sides: Vec::new(),
+    };
+    for (t, side) in s.triangles.iter().zip(&s.sides) {
+        let base = soup.points.len() as u32;
+        soup.points.extend(t.map(|v| s.points[v as usize]));
+        soup.triangles.push([base, base + 1, base + 2]);
+        soup.sides.push(*side);
+    }
+    for ext in ["ply", "obj"] {
+        let path = dir.path().join(format!("soup.{ext}"));
+        biotet_io::write_surface(&path, &soup).unwrap();
+        let out = dir.path().join(format!("soup_{ext}.vtu"));
+        let (p, o) = (path.to_str().unwrap(), out.to_str().unwrap());
+        let m = biotet(&["mesh", p, "-o", o, "--json"]);
+        assert!(
+            m.status.success(),
+            "{ext}: {}",
+            String::from_utf8_lossy(&m.stderr)
+        );
+        let j: serde_json::Value = serde_json::from_slice(&m.stdout).unwrap();
+        assert_eq!(j["pipeline"]["missing_triangles"], 0, "{ext}");
+        assert_eq!(j["quality"]["n_regions"], 1, "{ext}");
+        let c = biotet(&["check", o, "--surface", p, "--json"]);
+        let cj: serde_json::Value = serde_json::from_slice(&c.stdout).unwrap();
+        assert!(c.status.success() && cj["valid"] == true, "{ext}: {cj}");
+    }
+}

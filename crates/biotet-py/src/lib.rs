@@ -172,6 +172,8 @@ fn prepare(surface: Surface) -> Result<(SurfaceMesh, serde_json::Value), Failure
             Ok((s, serde_json::to_value(shells).unwrap_or_default()))
         }
         Surface::Sided(mut s, name) => {
+            // Copies of a point that differ only by index are one point, as in `assemble`.
+            s.weld_exact();
             let partial = s
                 .sides
                 .iter()

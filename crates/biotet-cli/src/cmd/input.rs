@@ -46,6 +46,11 @@ pub fn side_labelled(
     let name = path.display().to_string();
     let mut mesh = read.mesh;
     mesh.sides = read.side_labels.unwrap_or_default();
+    // Copies of a point that differ only by index are one point, as in `assemble`.
+    let welded = mesh.weld_exact();
+    if welded > 0 && !common.quiet && !common.json {
+        eprintln!("note: {name}: welded {welded} duplicate vertices");
+    }
     let partial = mesh.sides.iter().flatten().any(|&l| l == FROM_GEOMETRY);
     let invalid = || format!("{name}: invalid surface");
     let opts = ValidateOptions::default();
@@ -155,12 +160,11 @@ pub fn labelled_surface_report(
             note_touching(&s, &p.display().to_string(), common);
             return Ok((s, shells, report, p.display().to_string()));
         }
-        if read.welded > 0 && !common.quiet && !common.json {
-            eprintln!(
-                "note: {}: welded {} duplicate vertices",
-                p.display(),
-                read.welded
-            );
+        // `assemble` welds copies of a point in every format, as the STL reader does: the user
+        // hears how many.
+        let welded = read.welded + read.mesh.duplicate_points();
+        if welded > 0 && !common.quiet && !common.json {
+            eprintln!("note: {}: welded {welded} duplicate vertices", p.display());
         }
         parts.push(Part {
             surface: read.mesh,
@@ -241,12 +245,19 @@ fn assemble_validated(
         .with_context(|| format!("{name}: invalid surface"))?;
     if !common.quiet && !common.json {
         for (k, sh) in shells.iter().enumerate() {
+            let file = paths
+                .get(sh.part)
+                .map_or(name.to_string(), |p| p.display().to_string());
+            if sh.reoriented > 0 {
+                eprintln!(
+                    "note: {file}: {} of the {} triangles of shell {k} were turned to agree with \
+                     their neighbours",
+                    sh.reoriented, sh.n_triangles
+                );
+            }
             if sh.flipped {
                 eprintln!(
-                    "note: {}: shell {k} ({} triangles) faced inward and was flipped",
-                    paths
-                        .get(sh.part)
-                        .map_or(name.to_string(), |p| p.display().to_string()),
+                    "note: {file}: shell {k} ({} triangles) faced inward and was flipped",
                     sh.n_triangles
                 );
             }

@@ -1,7 +1,9 @@
 //! Several closed surfaces to one labelled surface: each closed shell encloses a region, and the
 //! region of a point is the label of the innermost shell containing it.
 //!
-//! Shells are the connected components of the input triangles (through shared edges). Each is
+//! Shells are the connected components of the input triangles (through shared edges), after
+//! the parts' points are welded (exactly equal coordinates are one point, so a triangle soup is
+//! the surface it describes). Each is
 //! oriented outward on its own (by its signed volume), then nested by exact point location
 //! ([`RegionLocator`]). A shell's triangles get `sides = [own label, label of the shell around
 //! it]` (0 when none). Two sibling shells that share triangles (touching tissues) keep one copy
@@ -42,6 +44,9 @@ pub struct Shell {
     pub parent: Option<usize>,
     /// Whether it was reversed to face outward.
     pub flipped: bool,
+    /// Triangles turned to agree with their neighbours before that (the shell's minority
+    /// orientation; see [`assemble`]).
+    pub reoriented: usize,
 }
 
 /// Why the shells cannot be assembled.
@@ -126,6 +131,75 @@ fn components(tris: &[[u32; 3]]) -> (Vec<u32>, usize) {
         *c = id[r];
     }
     (comp, n as usize)
+}
+
+/// Turn the triangles of one shell (connected through edges, at most two triangles an edge) that
+/// disagree with their neighbours: each edge then traversed once each way. The orientation of
+/// the shell's first triangle spreads through shared edges, and the smaller class is turned (the
+/// given one on a tie); the number turned. A shell where the spread meets itself turned (not
+/// orientable, or an edge of more than two triangles) is left as given: 0.
+fn orient_consistently(tris: &mut [[u32; 3]]) -> usize {
+    let n = tris.len();
+    // The (at most two) triangles of each edge.
+    let mut by_edge: FxHashMap<(u32, u32), [u32; 2]> = Default::default();
+    by_edge.reserve(3 * n / 2);
+    for (t, tri) in tris.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            let e = by_edge.entry((a.min(b), a.max(b))).or_insert([u32::MAX; 2]);
+            if e[0] == u32::MAX {
+                e[0] = t as u32;
+            } else if e[1] == u32::MAX {
+                e[1] = t as u32;
+            } else {
+                return 0;
+            }
+        }
+    }
+    // Whether triangle `t` runs a -> b as given.
+    let forward =
+        |tri: &[u32; 3], a: u32, b: u32| (0..3).any(|k| tri[k] == a && tri[(k + 1) % 3] == b);
+    let mut turn: Vec<Option<bool>> = vec![None; n];
+    let mut stack = Vec::new();
+    for start in 0..n {
+        if turn[start].is_some() {
+            continue;
+        }
+        turn[start] = Some(false);
+        stack.push(start as u32);
+        while let Some(t) = stack.pop() {
+            let tri = tris[t as usize];
+            let tt = turn[t as usize] == Some(true);
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                for u in by_edge[&(a.min(b), a.max(b))] {
+                    if u == t || u == u32::MAX {
+                        continue;
+                    }
+                    // t runs a -> b (turned or not); u must run b -> a.
+                    let want = forward(&tris[u as usize], a, b) != tt;
+                    match turn[u as usize] {
+                        None => {
+                            turn[u as usize] = Some(want);
+                            stack.push(u);
+                        }
+                        Some(x) if x != want => return 0,
+                        Some(_) => {}
+                    }
+                }
+            }
+        }
+    }
+    let turned = turn.iter().filter(|x| **x == Some(true)).count();
+    let flip_turned = 2 * turned <= n;
+    let mut count = 0;
+    for (tri, t) in tris.iter_mut().zip(&turn) {
+        if (*t == Some(true)) == flip_turned {
+            tri.swap(1, 2);
+            count += 1;
+        }
+    }
+    count
 }
 
 /// The closed surface `tris` alone, on its own points only (region 1 inside), for locating
@@ -270,6 +344,7 @@ pub fn label_arrangement(
             n_triangles: cell.iter().filter(|&&k| k as usize == c).count(),
             parent: None,
             flipped: false,
+            reoriented: 0,
         })
         .collect();
     Ok((
@@ -284,36 +359,55 @@ pub fn label_arrangement(
 
 /// Assemble parts into one surface with region labels; returns it and its shells.
 pub fn assemble(parts: Vec<Part>) -> Result<(SurfaceMesh, Vec<Shell>), AssembleError> {
-    if let Some(k) = parts
+    // One welded point set, before shells are found: copies of a point that differ only by
+    // index (a triangle soup, as a PLY or OBJ written without merging points) are one point,
+    // else each triangle of a soup is a shell of its own.
+    let mut points: Vec<[f64; 3]> = Vec::new();
+    let mut index: FxHashMap<[u64; 3], u32> = Default::default();
+    let part_tris: Vec<Vec<[u32; 3]>> = parts
         .iter()
-        .position(|p| is_non_manifold(&p.surface.triangles))
+        .map(|part| {
+            let map: Vec<u32> = part
+                .surface
+                .points
+                .iter()
+                .map(|p| {
+                    *index.entry(coord_key(p)).or_insert_with(|| {
+                        points.push(*p);
+                        (points.len() - 1) as u32
+                    })
+                })
+                .collect();
+            let tris = &part.surface.triangles;
+            tris.iter().map(|t| t.map(|v| map[v as usize])).collect()
+        })
+        .collect();
+    // A triangle whose corners welded together (distinct points in the file at one position)
+    // is left to the validation, which names it; the arrangement would only see bad edges.
+    let collapsed = |tris: &[[u32; 3]]| {
+        tris.iter()
+            .any(|t| t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
+    };
+    if let Some(k) = part_tris
+        .iter()
+        .position(|t| is_non_manifold(t) && !collapsed(t))
     {
         if parts.len() > 1 {
             return Err(AssembleError::NonManifoldWithOthers);
         }
-        let p = &parts[k];
-        return label_arrangement(&p.surface, p.labels.as_deref());
+        let s = SurfaceMesh {
+            points,
+            triangles: part_tris[k].clone(),
+            sides: parts[k].surface.sides.clone(),
+        };
+        return label_arrangement(&s, parts[k].labels.as_deref());
     }
-    // One welded point set.
-    let mut points: Vec<[f64; 3]> = Vec::new();
-    let mut index: FxHashMap<[u64; 3], u32> = Default::default();
-    // Shell triangles, per shell, in its part's numbering mapped to global points.
+    // Shell triangles, per shell, mapped to the welded points.
     let mut shell_tris: Vec<Vec<[u32; 3]>> = Vec::new();
     let mut shells: Vec<Shell> = Vec::new();
     let mut next_label = 1u32;
-    for (pi, part) in parts.iter().enumerate() {
-        let map: Vec<u32> = part
-            .surface
-            .points
-            .iter()
-            .map(|p| {
-                *index.entry(coord_key(p)).or_insert_with(|| {
-                    points.push(*p);
-                    (points.len() - 1) as u32
-                })
-            })
-            .collect();
-        let (comp, n) = components(&part.surface.triangles);
+    for (pi, (part, tris)) in parts.iter().zip(&part_tris).enumerate() {
+        let (comp, n) = components(tris);
         if let Some(l) = &part.labels
             && l.len() != n
         {
@@ -336,12 +430,20 @@ pub fn assemble(parts: Vec<Part>) -> Result<(SurfaceMesh, Vec<Shell>), AssembleE
                 n_triangles: 0,
                 parent: None,
                 flipped: false,
+                reoriented: 0,
             });
             shell_tris.push(Vec::new());
         }
-        for (t, tri) in part.surface.triangles.iter().enumerate() {
-            shell_tris[base + comp[t] as usize].push(tri.map(|v| map[v as usize]));
+        for (t, tri) in tris.iter().enumerate() {
+            shell_tris[base + comp[t] as usize].push(*tri);
         }
+    }
+    // A shell's triangles turned against their neighbours (a few reversed by an exporter): the
+    // minority turned, as the validation would ask. Orientation means nothing yet (the regions
+    // come from the nesting), so this is no guess; a shell that cannot be oriented is left for
+    // the validation to refuse.
+    for (s, tris) in shell_tris.iter_mut().enumerate() {
+        shells[s].reoriented = orient_consistently(tris);
     }
     // Orient each shell outward by its signed volume (a sign on a closed embedded shell; the
     // validation that follows confirms the shell is one).

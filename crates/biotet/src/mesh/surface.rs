@@ -162,6 +162,16 @@ impl SurfaceMesh {
         self.sides.extend_from_slice(&other.sides);
     }
 
+    /// How many points repeat the coordinates of an earlier one (what [`Self::weld_exact`]
+    /// would remove; -0.0 and 0.0 are the same coordinate).
+    pub fn duplicate_points(&self) -> usize {
+        let mut seen = rustc_hash::FxHashSet::default();
+        self.points
+            .iter()
+            .filter(|p| !seen.insert(super::coord_key(p)))
+            .count()
+    }
+
     /// Merge points with exactly equal coordinates (as STL needs), keeping the first occurrence's
     /// index order; returns the number of points removed. Deterministic.
     pub fn weld_exact(&mut self) -> usize {

@@ -309,3 +309,88 @@ fn one_shell_pinched_at_an_edge_stays_invalid() {
     let e = validate_surface(&mut one, &ValidateOptions::default()).unwrap_err();
     assert!(e.to_string().contains("(0, 0, 0)–(0, 0, 1)"), "{e}");
 }
+
+/// `s` as a triangle soup: every triangle on three points of its own (as a PLY or OBJ written
+/// without merging points, or an STL read as it is).
+fn soup(s: &SurfaceMesh) -> SurfaceMesh {
+    let mut out = SurfaceMesh {
+        points: Vec::new(),
+        triangles: Vec::new(),
+        sides: Vec::new(),
+    };
+    for (t, side) in s.triangles.iter().zip(&s.sides) {
+        let base = out.points.len() as u32;
+        out.points.extend(t.map(|v| s.points[v as usize]));
+        out.triangles.push([base, base + 1, base + 2]);
+        out.sides.push(*side);
+    }
+    out
+}
+
+#[test]
+fn a_triangle_soup_assembles_as_its_welded_surface() {
+    // Nested cubes, each a soup, and two cubes touching along an edge in one soup: the shells
+    // (and the arrangement's regions) are those of the welded surfaces, not one per triangle.
+    let outer = cube_surface([0.0; 3], 4.0);
+    let inner = cube_surface([1.0; 3], 2.0);
+    let welded = assemble(vec![part(inner.clone(), None), part(outer.clone(), None)]).unwrap();
+    let soups = assemble(vec![part(soup(&inner), None), part(soup(&outer), None)]).unwrap();
+    assert_eq!(soups.1.len(), 2);
+    assert_eq!(soups.0.points.len(), 16);
+    // The same triangles, corner for corner, and sides (the points numbered as they come).
+    let corners = |s: &SurfaceMesh| -> Vec<[[f64; 3]; 3]> {
+        (0..s.triangles.len()).map(|t| s.corners(t)).collect()
+    };
+    assert_eq!(corners(&soups.0), corners(&welded.0));
+    assert_eq!(soups.0.sides, welded.0.sides);
+    let mut pair = cube_surface([0.0; 3], 1.0);
+    pair.append(&cube_surface([1.0, 1.0, 0.0], 1.0));
+    let (mut s, shells) = assemble(vec![part(soup(&pair), None)]).unwrap();
+    assert_eq!(shells.len(), 2);
+    assert_eq!(s.points.len(), 14);
+    validate_surface(&mut s, &ValidateOptions::default()).unwrap();
+    assert_eq!(touching(&s).edges.len(), 1);
+    // A soup whose points collapse (two corners of a triangle at one position) is left to the
+    // validation, which names the triangle.
+    let mut flat = soup(&outer);
+    flat.points[1] = flat.points[0];
+    let (mut s, _) = assemble(vec![part(flat, None)]).unwrap();
+    let e = validate_surface(&mut s, &ValidateOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("degenerate"), "{e}");
+}
+
+#[test]
+fn triangles_turned_against_their_neighbours_are_turned_back() {
+    // A cube with one triangle turned, one with five (the minority), and nested cubes whose
+    // inner one has half its triangles turned: each shell comes out as the consistent cube's.
+    let cube = cube_surface([0.0; 3], 4.0);
+    let (good, _) = assemble(vec![part(cube.clone(), None)]).unwrap();
+    for turned in [&[3usize][..], &[0, 3, 5, 8, 11]] {
+        let mut s = cube.clone();
+        for &k in turned {
+            s.triangles[k].swap(1, 2);
+        }
+        let (mut out, shells) = assemble(vec![part(s, None)]).unwrap();
+        assert_eq!(shells[0].reoriented, turned.len());
+        assert!(!shells[0].flipped);
+        assert_eq!(out.triangles, good.triangles);
+        validate_surface(&mut out, &ValidateOptions::default()).unwrap();
+    }
+    let mut inner = cube_surface([1.0; 3], 2.0);
+    for k in (0..inner.triangles.len()).step_by(2) {
+        inner.triangles[k].swap(1, 2);
+    }
+    let (mut s, shells) = assemble(vec![part(inner, None), part(cube.clone(), None)]).unwrap();
+    assert_eq!(shells[0].reoriented, 6);
+    assert_eq!(shells[0].parent, Some(1));
+    assert_eq!(sides_of(&s), vec![[1, 2], [2, 0]]);
+    validate_surface(&mut s, &ValidateOptions::default()).unwrap();
+    // An open shell is turned the same way, and the validation still refuses it for its hole.
+    let mut open = cube.clone();
+    open.triangles.pop();
+    open.sides.pop();
+    open.triangles[0].swap(1, 2);
+    let (mut s, shells) = assemble(vec![part(open, None)]).unwrap();
+    assert_eq!(shells[0].reoriented, 1);
+    assert!(validate_surface(&mut s, &ValidateOptions::default()).is_err());
+}
