@@ -39,6 +39,8 @@ fn main() {
         ("ply", SurfaceFormat::PlyAscii, "ply"),
         ("mesh", SurfaceFormat::Medit, "medit_surface"),
         ("vtu", SurfaceFormat::Vtu, "vtu_surface"),
+        ("vtp", SurfaceFormat::Vtp, "vtp_surface"),
+        ("vtk", SurfaceFormat::Vtk, "vtk_surface"),
     ] {
         for (name, m) in [("ico", &tet4), ("cube", &cube)] {
             let p = tmp.join(format!("{name}_{f:?}.{ext}"));
@@ -76,6 +78,7 @@ fn main() {
         ("mesh", TetFormat::Medit, "medit_tet"),
         ("msh", TetFormat::Gmsh, "gmsh_tet"),
         ("msh", TetFormat::GmshBinary, "gmsh_tet"),
+        ("vtk", TetFormat::Vtk, "vtk_tet"),
     ] {
         let p = tmp.join(format!("cube_{f:?}.{ext}"));
         biotet_io::write_tet_mesh_as(&p, &tm, f).unwrap();
@@ -92,6 +95,13 @@ fn main() {
         biotet_io::vtu::write_tet_with(&mut v, &tm, "x.vtu", enc).unwrap();
         put("vtu_tet", &format!("cube_{name}.vtu"), &v);
     }
+    // Legacy VTK as VTK 9 writes it in ASCII (the 5.1 layout): one tet and a triangle.
+    let ascii51 = "# vtk DataFile Version 5.1\nvtk output\nASCII\nDATASET UNSTRUCTURED_GRID\n\
+                   POINTS 4 float\n0 0 0 1 0 0 0 1 0 0 0 1\nCELLS 3 7\nOFFSETS vtktypeint64\n0 4 7\n\
+                   CONNECTIVITY vtktypeint64\n0 1 2 3 0 2 1\nCELL_TYPES 2\n10\n5\n\
+                   CELL_DATA 2\nSCALARS region int 1\nLOOKUP_TABLE default\n3 0\n";
+    put("vtk_tet", "one_tet_51.vtk", ascii51.as_bytes());
+    put("vtk_surface", "one_tet_51.vtk", ascii51.as_bytes());
     let p = tmp.join("cube.node");
     let written = biotet_io::write_tet_mesh_as(&p, &tm, TetFormat::TetGen).unwrap();
     let node = fs::read(&written[0]).unwrap();

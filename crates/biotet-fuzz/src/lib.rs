@@ -29,8 +29,11 @@ pub const TARGETS: &[&str] = &[
     "off",
     "ply",
     "vtu_surface",
+    "vtp_surface",
+    "vtk_surface",
     "medit_surface",
     "vtu_tet",
+    "vtk_tet",
     "medit_tet",
     "gmsh_tet",
     "tetgen_tet",
@@ -111,8 +114,11 @@ pub fn run(target: &str, data: &[u8]) -> bool {
         "off" => surface(biotet_io::off::parse(data, F), F),
         "ply" => surface(biotet_io::ply::parse(data, F), F),
         "vtu_surface" => surface(biotet_io::vtu::parse_surface(data, F), F),
+        "vtp_surface" => surface(biotet_io::vtp::parse_surface(data, F), F),
+        "vtk_surface" => surface(biotet_io::vtk::parse_surface(data, F), F),
         "medit_surface" => surface(biotet_io::medit::parse_surface(data, F), F),
         "vtu_tet" => tet(biotet_io::vtu::parse_tet(data, F), F),
+        "vtk_tet" => tet(biotet_io::vtk::parse_tet(data, F), F),
         "medit_tet" => tet(biotet_io::medit::parse_tet(data, F), F),
         "gmsh_tet" => tet(biotet_io::gmsh::parse_tet(data, F), F),
         "tetgen_tet" => {
@@ -144,6 +150,7 @@ pub fn run(target: &str, data: &[u8]) -> bool {
             for r in [
                 biotet_io::medit::peek_kind(data, F).map(|_| ()),
                 biotet_io::vtu::peek_kind(data, F).map(|_| ()),
+                biotet_io::vtk::peek_kind(data, F).map(|_| ()),
                 biotet_io::tetgen::peek_dim(data, F).map(|_| ()),
             ] {
                 if let Err(e) = r {

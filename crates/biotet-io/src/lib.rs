@@ -2,8 +2,8 @@
 //!
 //! | kind | formats (extension, case-insensitive) | read | write |
 //! |---|---|---|---|
-//! | surface ([`SurfaceMesh`]) | STL `.stl` (ASCII/binary), OBJ `.obj`, OFF `.off`, PLY `.ply` (ASCII/binary LE/BE), Medit `.mesh`, VTU `.vtu` (triangles with side labels) | ✓ | ✓ |
-//! | tet mesh ([`TetMesh`]) | VTU `.vtu`, Medit `.mesh`, Gmsh `.msh` (4.1 ASCII/binary, 2.2 ASCII), TetGen `.node`/`.ele`(/`.face`) | ✓ | ✓ |
+//! | surface ([`SurfaceMesh`]) | STL `.stl` (ASCII/binary), OBJ `.obj`, OFF `.off`, PLY `.ply` (ASCII/binary LE/BE), Medit `.mesh`, VTU `.vtu` (triangles with side labels), VTP `.vtp` (poly data, [`vtp`]), legacy VTK `.vtk` ([`vtk`]; written binary) | ✓ | ✓ |
+//! | tet mesh ([`TetMesh`]) | VTU `.vtu`, legacy VTK `.vtk` ([`vtk`]; written binary), Medit `.mesh`, Gmsh `.msh` (4.1 ASCII/binary, 2.2 ASCII), TetGen `.node`/`.ele`(/`.face`) | ✓ | ✓ |
 //! | 2D mesh ([`TriMesh`]) | Medit `.mesh` (`Dimension 2`), Triangle `.node`/`.ele` | ✓ | ✓ |
 //! | 2D mesh ([`TriMesh`]) | VTU `.vtu`, Gmsh `.msh` (2.2 ASCII) | | ✓ |
 //! | PSLG ([`biotet::mesh::pslg::Pslg`]) | Triangle `.poly`, `.node`/`.edge`, Medit `.mesh` (`Dimension 2`, `Edges`) ([`poly`]) | ✓ | `.poly` |
@@ -55,7 +55,10 @@ pub mod poly;
 pub mod stl;
 pub mod tetgen;
 mod text;
+pub mod vtk;
+mod vtk_out;
 mod vtkxml;
+pub mod vtp;
 pub mod vtu;
 mod vtu_out;
 
@@ -159,6 +162,10 @@ pub enum SurfaceFormat {
     Medit,
     /// VTK XML unstructured grid `.vtu` of triangles with side labels ([`vtu::parse_surface`]).
     Vtu,
+    /// VTK XML poly data `.vtp` (polygons and strips; side labels as in `.vtu`, see [`vtp`]).
+    Vtp,
+    /// Legacy VTK `.vtk` (read: [`vtk`]; written binary, `POLYDATA` with `sides`).
+    Vtk,
 }
 
 /// Tet mesh file formats.
@@ -174,6 +181,8 @@ pub enum TetFormat {
     GmshBinary,
     /// TetGen `.node`/`.ele`/`.face` (see [`tetgen`] for the naming rule).
     TetGen,
+    /// Legacy VTK `.vtk` (read: [`vtk`]; written binary, `UNSTRUCTURED_GRID` with `region`).
+    Vtk,
 }
 
 /// 2D triangle mesh file formats.
@@ -190,12 +199,12 @@ pub enum TriFormat {
 }
 
 /// Supported surface extensions, for messages.
-pub const SURFACE_EXTENSIONS: &str = ".stl, .obj, .off, .ply, .mesh, .vtu";
+pub const SURFACE_EXTENSIONS: &str = ".stl, .obj, .off, .ply, .mesh, .vtu, .vtp, .vtk";
 /// Supported tet mesh extensions, for messages.
-pub const TET_EXTENSIONS: &str = ".vtu, .mesh, .msh, .node/.ele (TetGen)";
+pub const TET_EXTENSIONS: &str = ".vtu, .vtk, .mesh, .msh, .node/.ele (TetGen)";
 /// Supported 2D mesh extensions, for messages.
 pub const TRI_EXTENSIONS: &str = ".mesh, .node/.ele (Triangle); writing also .vtu, .msh";
-const ALL_EXTENSIONS: &str = ".stl, .obj, .off, .ply, .mesh, .vtu, .msh, .node, .ele";
+const ALL_EXTENSIONS: &str = ".stl, .obj, .off, .ply, .mesh, .vtu, .vtp, .vtk, .msh, .node, .ele";
 
 /// The lower-case extension of a path.
 fn ext(path: &Path) -> String {
@@ -219,6 +228,8 @@ impl SurfaceFormat {
             "ply" => SurfaceFormat::Ply,
             "mesh" => SurfaceFormat::Medit,
             "vtu" => SurfaceFormat::Vtu,
+            "vtp" => SurfaceFormat::Vtp,
+            "vtk" => SurfaceFormat::Vtk,
             _ => {
                 return Err(Error::UnknownExtension {
                     path: name(path),
@@ -238,6 +249,7 @@ impl TetFormat {
             "mesh" => TetFormat::Medit,
             "msh" => TetFormat::Gmsh,
             "node" | "ele" | "face" => TetFormat::TetGen,
+            "vtk" => TetFormat::Vtk,
             _ => {
                 return Err(Error::UnknownExtension {
                     path: name(path),
@@ -269,16 +281,20 @@ impl TriFormat {
 }
 
 /// Which kind of mesh `path` holds: by extension, looking inside `.mesh` files (their
-/// `Dimension` and whether they have tetrahedra, see [`medit::peek_kind`]), `.vtu` files (volume
-/// or surface cells, [`vtu::peek_kind`]) and TetGen/Triangle
+/// `Dimension` and whether they have tetrahedra, see [`medit::peek_kind`]), `.vtu` and `.vtk`
+/// files (volume or surface cells, [`vtu::peek_kind`], [`vtk::peek_kind`]) and TetGen/Triangle
 /// `.node`/`.ele` files (the dimension in the `.node` header).
 pub fn mesh_kind(path: &Path) -> Result<MeshKind> {
     match ext(path).as_str() {
-        "stl" | "obj" | "off" | "ply" => Ok(MeshKind::Surface),
+        "stl" | "obj" | "off" | "ply" | "vtp" => Ok(MeshKind::Surface),
         "msh" => Ok(MeshKind::Tetrahedra),
         // Unreadable: by extension; reading it will say why.
         "vtu" => match atomic::read_file(path) {
             Ok(data) => vtu::peek_kind(&data, &name(path)),
+            Err(_) => Ok(MeshKind::Tetrahedra),
+        },
+        "vtk" => match atomic::read_file(path) {
+            Ok(data) => vtk::peek_kind(&data, &name(path)),
             Err(_) => Ok(MeshKind::Tetrahedra),
         },
         "mesh" => medit::peek_kind(atomic::open(path)?, &name(path)),
@@ -313,6 +329,8 @@ pub fn read_surface_as(path: &Path, format: SurfaceFormat) -> Result<SurfaceRead
         SurfaceFormat::Ply | SurfaceFormat::PlyAscii => ply::parse(&data, &n),
         SurfaceFormat::Medit => medit::parse_surface(&data, &n),
         SurfaceFormat::Vtu => vtu::parse_surface(&data, &n),
+        SurfaceFormat::Vtp => vtp::parse_surface(&data, &n),
+        SurfaceFormat::Vtk => vtk::parse_surface(&data, &n),
     }
 }
 
@@ -333,6 +351,8 @@ pub fn write_surface_as(path: &Path, mesh: &SurfaceMesh, format: SurfaceFormat) 
         SurfaceFormat::PlyAscii => ply::write_ascii(w, mesh, &n),
         SurfaceFormat::Medit => medit::write_surface(w, mesh, &n),
         SurfaceFormat::Vtu => vtu::write_surface(w, mesh, &n),
+        SurfaceFormat::Vtp => vtp::write_surface(w, mesh, &n),
+        SurfaceFormat::Vtk => vtk_out::write_surface(w, mesh, &n),
     })
 }
 
@@ -346,6 +366,7 @@ pub fn read_tet_mesh_as(path: &Path, format: TetFormat) -> Result<TetRead> {
     let n = name(path);
     match format {
         TetFormat::Vtu => vtu::parse_tet(&atomic::read_file(path)?, &n),
+        TetFormat::Vtk => vtk::parse_tet(&atomic::read_file(path)?, &n),
         TetFormat::Medit => medit::parse_tet(&atomic::read_file(path)?, &n),
         TetFormat::Gmsh | TetFormat::GmshBinary => gmsh::parse_tet(&atomic::read_file(path)?, &n),
         TetFormat::TetGen => {
@@ -374,6 +395,7 @@ pub fn write_tet_mesh_as(path: &Path, mesh: &TetMesh, format: TetFormat) -> Resu
     };
     match format {
         TetFormat::Vtu => one(&|w| vtu::write_tet(w, mesh, &n)),
+        TetFormat::Vtk => one(&|w| vtk_out::write_tet(w, mesh, &n)),
         TetFormat::Medit => one(&|w| medit::write_tet(w, mesh, &n)),
         TetFormat::Gmsh => one(&|w| gmsh::write_tet(w, mesh, &n)),
         TetFormat::GmshBinary => one(&|w| gmsh::write_tet_binary(w, mesh, &n)),

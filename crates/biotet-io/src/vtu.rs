@@ -93,7 +93,7 @@ fn tet_arrays<'a>(mesh: &'a TetMesh, file: &str) -> Result<Vec<Array<'a>>> {
 }
 
 /// The `connectivity` array of cells with `K` corners (`Int64` if `wide`, else `Int32`).
-fn cells_connectivity<const K: usize>(cells: &[[u32; K]], wide: bool) -> Array<'_> {
+pub(crate) fn cells_connectivity<const K: usize>(cells: &[[u32; K]], wide: bool) -> Array<'_> {
     if wide {
         Array::new("connectivity", 1, Ty::I64, K * cells.len(), move |r| {
             let c = &cells.as_flattened()[r];
@@ -109,7 +109,7 @@ fn cells_connectivity<const K: usize>(cells: &[[u32; K]], wide: bool) -> Array<'
 
 /// The `offsets` array of `n` cells of `K` corners each: `K, 2K, …` (`Int64` if `wide`, else
 /// `Int32`).
-fn cells_offsets<'a, const K: usize>(n: usize, wide: bool) -> Array<'a> {
+pub(crate) fn cells_offsets<'a, const K: usize>(n: usize, wide: bool) -> Array<'a> {
     let end = |r: std::ops::Range<usize>| (r.start as i64 + 1..=r.end as i64).map(|i| K as i64 * i);
     if wide {
         Array::new("offsets", 1, Ty::I64, n, move |r| {
@@ -145,7 +145,8 @@ fn write_tet_chunked<W: Write>(
     check_tet(mesh, file)?;
     let arrays = tet_arrays(mesh, file)?;
     let sizes = (mesh.points.len(), mesh.tets.len());
-    vtu_out::write_grid(w, sizes, &arrays, (4, "region"), file, enc, chunk)
+    let grid = vtu_out::Grid::Unstructured;
+    vtu_out::write_grid(w, grid, sizes, &arrays, (4, "region"), file, enc, chunk)
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -168,7 +169,7 @@ pub fn read_tet<R: Read>(r: R, file: &str) -> Result<TetRead> {
 }
 
 /// VTK cell types that are volumes (other than the linear tet, 10).
-fn is_volume_cell(t: i64) -> bool {
+pub(crate) fn is_volume_cell(t: i64) -> bool {
     matches!(t, 10..=16 | 24..=27 | 29 | 32 | 33 | 42 | 71..=74 | 78..=81)
 }
 
@@ -267,24 +268,25 @@ fn read_pieces<'a>(data: &'a [u8], file: &'a str) -> Result<(Ctx<'a>, Vec<Piece<
 }
 
 /// Append the points of piece `pi` to `points`.
-fn read_points(ctx: &Ctx, p: &Piece, pi: usize, points: &mut Vec<[f64; 3]>) -> Result<()> {
+pub(crate) fn read_points(
+    ctx: &Ctx,
+    (npts, array): (usize, Option<&ArrayRef>),
+    pi: usize,
+    points: &mut Vec<[f64; 3]>,
+) -> Result<()> {
     let file = ctx.file;
     let base = points.len();
-    if p.npts == 0 {
+    if npts == 0 {
         return Ok(());
     }
-    let a = p
-        .points
-        .as_ref()
-        .ok_or_else(|| Error::format(file, format!("piece {pi} has no Points array")))?;
+    let a = array.ok_or_else(|| Error::format(file, format!("piece {pi} has no Points array")))?;
     if a.ncomp != 3 {
         return Err(ctx.err_at(
             a.at,
             format!("Points with {} components, expected 3", a.ncomp),
         ));
     }
-    let cap = p
-        .npts
+    let cap = npts
         .checked_mul(3)
         .ok_or_else(|| Error::format(file, "too many points"))?;
     let v = match ctx.values(a, Some(cap))? {
@@ -331,7 +333,7 @@ fn read_cells(ctx: &Ctx, p: &Piece, pi: usize) -> Result<(Vec<i64>, Vec<i64>, Ve
 
 /// The point indices of cell `i`, checked against the connectivity and the piece's points and
 /// shifted by `base`; `prev` is the end of the previous cell in the connectivity.
-fn cell_points(
+pub(crate) fn cell_points(
     file: &str,
     i: usize,
     (offsets, conn): (&[i64], &[i64]),
@@ -379,7 +381,7 @@ pub fn parse_tet(data: &[u8], file: &str) -> Result<TetRead> {
     let mut c: Vec<u32> = Vec::new();
     for (pi, p) in pieces.iter().enumerate() {
         let base = points.len();
-        read_points(&ctx, p, pi, &mut points)?;
+        read_points(&ctx, (p.npts, p.points.as_ref()), pi, &mut points)?;
         if p.ncells == 0 {
             continue;
         }
@@ -439,9 +441,9 @@ fn is_surface_cell(t: i64) -> bool {
 
 /// Two-component cell-data arrays holding the side labels `[back, front]`, in order of
 /// preference (`sides`: biotet; `BoundaryLabels`: VTK's SurfaceNets; `boundary_labels`: PyVista).
-const SIDE_ARRAYS: [&str; 3] = ["sides", "BoundaryLabels", "boundary_labels"];
+pub(crate) const SIDE_ARRAYS: [&str; 3] = ["sides", "BoundaryLabels", "boundary_labels"];
 /// Scalar cell-data array pairs holding the side labels, `(back, front)`.
-const SIDE_PAIRS: [(&str, &str); 2] = [
+pub(crate) const SIDE_PAIRS: [(&str, &str); 2] = [
     ("label_back", "label_front"),
     ("region_back", "region_front"),
 ];
@@ -491,7 +493,7 @@ pub fn parse_surface(data: &[u8], file: &str) -> Result<SurfaceRead> {
     let mut c: Vec<u32> = Vec::new();
     for (pi, p) in pieces.iter().enumerate() {
         let base = points.len();
-        read_points(&ctx, p, pi, &mut points)?;
+        read_points(&ctx, (p.npts, p.points.as_ref()), pi, &mut points)?;
         if p.ncells == 0 {
             continue;
         }
@@ -624,6 +626,7 @@ pub fn write_surface<W: Write>(w: W, mesh: &SurfaceMesh, file: &str) -> Result<(
     ];
     vtu_out::write_grid(
         w,
+        vtu_out::Grid::Unstructured,
         (np, nt),
         &arrays,
         (4, "sides"),

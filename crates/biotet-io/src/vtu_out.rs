@@ -224,11 +224,23 @@ fn compress(a: &Array, chunk: usize, file: &str) -> Result<(Vec<u8>, Vec<u8>)> {
     Ok((header, payload))
 }
 
-/// Write an unstructured grid of `sizes = (points, cells)` from its arrays: `Points`, the three
-/// cell arrays, then cell data from index `first_cell_array` on, `scalars` the active one.
-/// Arrays are made and encoded `chunk` tuples at a time.
+/// The kind of VTK XML grid [`write_grid`] writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Grid {
+    /// `UnstructuredGrid` (`.vtu`): cells as connectivity, offsets and types.
+    Unstructured,
+    /// `PolyData` (`.vtp`): polygons as connectivity and offsets.
+    Poly,
+}
+
+/// Write a grid of `sizes = (points, cells)` from its arrays: `Points`, the cell arrays (three
+/// for [`Grid::Unstructured`], two polygon arrays for [`Grid::Poly`]), then cell data from index
+/// `first_cell_array` on, `scalars` the active one. Arrays are made and encoded `chunk` tuples at
+/// a time.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn write_grid<W: Write>(
     w: W,
+    grid: Grid,
     sizes: (usize, usize),
     arrays: &[Array],
     (first_cell_array, scalars): (usize, &str),
@@ -239,13 +251,23 @@ pub(crate) fn write_grid<W: Write>(
     let zlib = matches!(enc, VtuEncoding::RawZlib | VtuEncoding::Base64Zlib);
     let io = |e| Error::io(file, e);
     let mut out = Out::new(w);
-    out.s("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\"");
+    let (kind, cells_attr, section) = match grid {
+        Grid::Unstructured => ("UnstructuredGrid", "NumberOfCells", "Cells"),
+        Grid::Poly => ("PolyData", "NumberOfPolys", "Polys"),
+    };
+    out.s("<?xml version=\"1.0\"?>\n<VTKFile type=\"");
+    out.s(kind);
+    out.s("\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\"");
     if zlib {
         out.s(" compressor=\"vtkZLibDataCompressor\"");
     }
-    out.s(">\n  <UnstructuredGrid>\n    <Piece NumberOfPoints=\"");
+    out.s(">\n  <");
+    out.s(kind);
+    out.s(">\n    <Piece NumberOfPoints=\"");
     out.int(sizes.0);
-    out.s("\" NumberOfCells=\"");
+    out.s("\" ");
+    out.s(cells_attr);
+    out.s("=\"");
     out.int(sizes.1);
     out.s("\">\n");
     // Compressed appended blocks are made up front: the offsets depend on their sizes.
@@ -260,7 +282,11 @@ pub(crate) fn write_grid<W: Write>(
     for (k, a) in arrays.iter().enumerate() {
         match k {
             0 => out.s("      <Points>\n"),
-            1 => out.s("      <Cells>\n"),
+            1 => {
+                out.s("      <");
+                out.s(section);
+                out.s(">\n");
+            }
             _ if k == first_cell_array => {
                 out.s("      <CellData Scalars=\"");
                 out.s(scalars);
@@ -338,13 +364,17 @@ pub(crate) fn write_grid<W: Write>(
             }
         }
         out.check().map_err(io)?;
-        match k {
-            0 => out.s("      </Points>\n"),
-            3 => out.s("      </Cells>\n"),
-            _ => {}
+        if k == 0 {
+            out.s("      </Points>\n");
+        } else if k + 1 == first_cell_array {
+            out.s("      </");
+            out.s(section);
+            out.s(">\n");
         }
     }
-    out.s("      </CellData>\n    </Piece>\n  </UnstructuredGrid>\n");
+    out.s("      </CellData>\n    </Piece>\n  </");
+    out.s(kind);
+    out.s(">\n");
     if matches!(enc, VtuEncoding::Raw | VtuEncoding::RawZlib) {
         out.s("  <AppendedData encoding=\"raw\">\n   _");
         for (k, a) in arrays.iter().enumerate() {

@@ -833,6 +833,19 @@ fn read_tet_mesh<'py>(py: Python<'py>, path: PathBuf) -> PyResult<MeshOut<'py>> 
     Ok(mesh_out(py, mesh, "{}".into()))
 }
 
+/// Which kind of mesh a file holds, as `biotet` tells (extension, then a look inside `.vtu`,
+/// `.vtk`, `.mesh` and `.node` files): "surface", "tetrahedra" or "triangles2d".
+#[pyfunction]
+fn mesh_kind(py: Python<'_>, path: PathBuf) -> PyResult<&'static str> {
+    guarded(py, None, move || {
+        Ok(match biotet_io::mesh_kind(&path).map_err(Failure::io)? {
+            biotet_io::MeshKind::Surface => "surface",
+            biotet_io::MeshKind::Tetrahedra => "tetrahedra",
+            biotet_io::MeshKind::Triangles2d => "triangles2d",
+        })
+    })
+}
+
 /// Read a surface file: (points, triangles, sides) with sides the region labels behind and in
 /// front of each triangle (`[1, 0]` for a plain closed surface).
 #[pyfunction]
@@ -882,6 +895,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(smooth_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(read_tet_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(read_surface, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh_kind, m)?)?;
     m.add_function(wrap_pyfunction!(write_tet_mesh, m)?)?;
     Ok(())
 }

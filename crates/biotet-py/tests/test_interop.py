@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import biotet
-from conftest import SHAPES, cube
+from conftest import SHAPES, cube, run_cli
 
 
 @pytest.fixture(scope="module")
@@ -61,3 +61,61 @@ def test_dolfinx_mesh_with_the_labels_as_meshtags():
         )
         assert got == pytest.approx(want[label], rel=1e-12)
     assert want[3] == pytest.approx(8.0) and want[7] == pytest.approx(56.0)
+
+
+def test_surfaces_pyvista_writes_mesh(tmp_path, cli):
+    """A sphere PyVista writes as VTP or legacy VTK (binary and ASCII, polygons and triangle
+    strips) meshes with every triangle kept, and the VTP and VTK biotet writes read back in
+    PyVista with their sides."""
+    pv = pytest.importorskip("pyvista")
+    sphere = pv.Sphere(theta_resolution=24, phi_resolution=12)
+    strips = sphere.strip()
+    assert strips.n_strips > 0
+    for name, mesh, binary in [
+        ("polys.vtp", sphere, True),
+        ("polys_ascii.vtp", sphere, False),
+        ("strips.vtp", strips, True),
+        ("polys.vtk", sphere, True),
+        ("polys_ascii.vtk", sphere, False),
+        ("strips.vtk", strips, True),
+    ]:
+        path = tmp_path / name
+        mesh.save(path, binary=binary)
+        s = biotet.read(path)
+        assert isinstance(s, biotet.Surface), name
+        assert len(s.triangles) == sphere.n_cells, name
+        # VTK's ASCII writers keep six digits of a float32; binary files are exact.
+        np.testing.assert_allclose(np.unique(s.points, axis=0),
+                                   np.unique(np.asarray(sphere.points), axis=0),
+                                   rtol=0 if binary else 1e-5, atol=0 if binary else 1e-6)
+        m = biotet.mesh_file(path)
+        c = biotet.check(m, s)
+        assert c["valid"] and c["surface"]["n_missing"] == 0, (name, c)
+    for ext in ("vtp", "vtk"):
+        out = tmp_path / f"back.{ext}"
+        r = run_cli(cli, "convert", tmp_path / "polys.vtp", "-o", out)
+        assert r.returncode == 0, r.stderr
+        back = pv.read(out)
+        assert back.n_cells == sphere.n_cells, ext
+        sides = np.asarray(back.cell_data["sides"])
+        assert np.array_equal(sides, np.tile([1, 0], (back.n_cells, 1))), ext
+
+
+def test_a_tet_mesh_through_legacy_vtk(tmp_path, torus):
+    """A tet mesh biotet writes as legacy VTK reads in PyVista with its regions, and one PyVista
+    writes (binary and ASCII) reads back in biotet with the same tets and labels."""
+    pv = pytest.importorskip("pyvista")
+    path = tmp_path / "t.vtk"
+    torus.write(path)
+    g = pv.read(path)
+    assert g.n_cells == torus.n_tets
+    assert np.array_equal(np.asarray(g.cell_data["region"]), torus.labels)
+    for binary in (True, False):
+        back_path = tmp_path / f"pv_{binary}.vtk"
+        torus.to_pyvista().save(back_path, binary=binary)
+        back = biotet.read(back_path)
+        # VTK's ASCII writer keeps eleven digits of a double; its binary files are exact.
+        np.testing.assert_allclose(back.points, torus.points, rtol=0 if binary else 1e-9,
+                                   atol=0 if binary else 1e-10)
+        np.testing.assert_array_equal(back.tets, torus.tets)
+        np.testing.assert_array_equal(back.labels, torus.labels)

@@ -15,7 +15,7 @@ Examples:
 #[derive(clap::Args)]
 #[command(after_help = EXAMPLES)]
 pub struct Args {
-    /// The tet mesh: .vtu, .mesh, .msh, or TetGen .node/.ele.
+    /// The tet mesh: .vtu, .vtk, .mesh, .msh, or TetGen .node/.ele.
     mesh: PathBuf,
     /// A surface whose every triangle must be a face of the mesh (matched by exact
     /// coordinates, either orientation). Repeat for several surfaces.

@@ -21,15 +21,15 @@ Examples:
 pub struct Args {
     /// Input mesh; its format is chosen by extension.
     input: PathBuf,
-    /// Output mesh; its format is chosen by extension (.vtu .mesh .msh .node/.ele for tets and
-    /// 2D triangles; .stl .obj .off .ply .mesh .vtu for surfaces).
+    /// Output mesh; its format is chosen by extension (.vtu .vtk .mesh .msh .node/.ele for tets and
+    /// 2D triangles; .stl .obj .off .ply .mesh .vtu .vtp .vtk for surfaces).
     #[arg(short, long, value_name = "OUT")]
     output: PathBuf,
     /// For a surface: label its regions as `biotet mesh` does (closed shells nested innermost
-    /// first, or a non-manifold surface's cells; validated) and write the labels of both sides
-    /// of every triangle (.vtu `sides`, .ply `label_back`/`label_front`, .mesh refs). A surface
-    /// that already has side labels keeps them (checked against the geometry when some side is
-    /// left to it).
+    /// first, or a non-manifold surface's cells; validated) and write the labels of both sides of
+    /// every triangle (.vtu, .vtp and .vtk `sides`, .ply `label_back`/`label_front`, .mesh refs). A
+    /// surface that already has side labels keeps them (checked against the geometry when some side
+    /// is left to it).
     #[arg(long)]
     regions: bool,
     #[command(flatten)]
@@ -45,17 +45,17 @@ pub fn run(a: Args) -> Result<ExitCode> {
         .extension()
         .map(|e| e.to_string_lossy().to_lowercase())
         .unwrap_or_default();
-    let surface_ext = ["stl", "obj", "off", "ply"].contains(&out_ext.as_str());
+    let surface_ext = ["stl", "obj", "off", "ply", "vtp"].contains(&out_ext.as_str());
     if surface_ext && kind != MeshKind::Surface {
         anyhow::bail!(
             "{}: cannot write a volume or 2D mesh as a surface (.{out_ext}); \
-             use .vtu, .mesh, .msh or .node/.ele",
+             use .vtu, .vtk, .mesh, .msh or .node/.ele",
             a.output.display()
         );
     }
     if kind == MeshKind::Surface && ["msh", "node", "ele"].contains(&out_ext.as_str()) {
         anyhow::bail!(
-            "{}: {} is a surface; write it as .stl, .obj, .off, .ply, .mesh or .vtu \
+            "{}: {} is a surface; write it as .stl, .obj, .off, .ply, .mesh, .vtu or .vtp \
              (meshing a surface is `biotet mesh`, coming with the mesher)",
             a.output.display(),
             a.input.display()

@@ -20,8 +20,8 @@ Examples:
 pub struct Args {
     /// The points: a TetGen .node file, or text with one `x y z` point per line (`#` comments).
     points: PathBuf,
-    /// Output tet mesh (.vtu, .mesh, .msh, .node/.ele). Without it, the triangulation is built
-    /// and measured only.
+    /// Output tet mesh (.vtu, .vtk, .mesh, .msh, .node/.ele). Without it, the triangulation is
+    /// built and measured only.
     #[arg(short, long, value_name = "OUT")]
     output: Option<PathBuf>,
     #[command(flatten)]

@@ -27,13 +27,13 @@ Examples:
 #[derive(clap::Args)]
 #[command(after_help = EXAMPLES)]
 pub struct Args {
-    /// The tet mesh: .vtu, .mesh, .msh, or TetGen .node/.ele.
+    /// The tet mesh: .vtu, .vtk, .mesh, .msh, or TetGen .node/.ele.
     mesh: PathBuf,
     /// The input surface (repeat for several): used to report forced tets. Boundary and
     /// interface faces are kept whether it is given or not.
     #[arg(long = "surface", short = 's', value_name = "SURFACE")]
     surfaces: Vec<PathBuf>,
-    /// Output tet mesh (.vtu, .mesh, .msh, .node/.ele).
+    /// Output tet mesh (.vtu, .vtk, .mesh, .msh, .node/.ele).
     #[arg(short, long, value_name = "OUT")]
     output: PathBuf,
     /// Which measure selects and judges tets.

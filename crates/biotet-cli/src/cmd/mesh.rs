@@ -50,17 +50,18 @@ Examples:
 #[command(group(clap::ArgGroup::new("sizing").args(["size", "size_from_surface", "size_field"])))]
 #[command(after_help = EXAMPLES)]
 pub struct Args {
-    /// Closed surfaces (.stl, .obj, .off, .ply, .mesh, .vtu). Every closed shell encloses a
-    /// region; a point belongs to the innermost shell around it. Shells are labelled 1, 2, … in
-    /// order of files and of shells within a file, unless --label says otherwise. Without a
+    /// Closed surfaces (.stl, .obj, .off, .ply, .mesh, .vtu, .vtp, .vtk). Every closed shell
+    /// encloses a region; a point belongs to the innermost shell around it. Shells are labelled 1,
+    /// 2, … in order of files and of shells within a file, unless --label says otherwise. Without a
     /// surface, the bundled brain example is meshed. A 2D planar straight-line graph (.poly,
-    /// .node/.edge, or a Dimension 2 .mesh with Edges) is meshed in 2D (see docs/commands.md, "2D meshes").
+    /// .node/.edge, or a Dimension 2 .mesh with Edges) is meshed in 2D (see docs/commands.md, "2D
+    /// meshes").
     surfaces: Vec<PathBuf>,
     /// Labels of one file's shells in order, as FILE=N[,N...] (repeatable); 0 makes a shell a
     /// cavity (not meshed).
     #[arg(long, value_name = "FILE=N[,N...]")]
     label: Vec<String>,
-    /// Output tet mesh (.vtu, .mesh, .msh, .node/.ele). Without it, the mesh is built and
+    /// Output tet mesh (.vtu, .vtk, .mesh, .msh, .node/.ele). Without it, the mesh is built and
     /// reported only. A run that fails (exit 1) neither creates nor replaces it.
     #[arg(short, long, value_name = "OUT")]
     output: Option<PathBuf>,

@@ -19,7 +19,7 @@ Examples:
 #[derive(clap::Args)]
 #[command(after_help = EXAMPLES)]
 pub struct Args {
-    /// The mesh: .vtu, .mesh, .msh, or TetGen .node/.ele (tets or 2D triangles).
+    /// The mesh: .vtu, .vtk, .mesh, .msh, or TetGen .node/.ele (tets or 2D triangles).
     mesh: PathBuf,
     /// Also draw the dihedral- and solid-angle histograms (angle histogram in 2D) to this SVG.
     #[arg(long, value_name = "FILE")]
@@ -55,7 +55,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
     if kind == MeshKind::Surface {
         anyhow::bail!(
             "{}: a surface file; `biotet quality` measures tet meshes and 2D triangle meshes \
-             (.vtu, .mesh, .msh, .node/.ele)",
+             (.vtu, .vtk, .mesh, .msh, .node/.ele)",
             a.mesh.display()
         );
     }

@@ -22,14 +22,14 @@ Examples:
 #[derive(clap::Args)]
 #[command(after_help = EXAMPLES)]
 pub struct Args {
-    /// The tet mesh (any tool's): .vtu, .mesh, .msh, or TetGen .node/.ele. Its boundary must be
-    /// convex (a Delaunay mesh of the hull), or its tets Delaunay tets of its points with the
+    /// The tet mesh (any tool's): .vtu, .vtk, .mesh, .msh, or TetGen .node/.ele. Its boundary must
+    /// be convex (a Delaunay mesh of the hull), or its tets Delaunay tets of its points with the
     /// outside removed.
     mesh: PathBuf,
     /// The surface whose triangles must be faces (repeat for several).
     #[arg(long = "surface", short = 's', value_name = "SURFACE", required = true)]
     surfaces: Vec<PathBuf>,
-    /// Output tet mesh (.vtu, .mesh, .msh, .node/.ele). Not written when some triangles stay
+    /// Output tet mesh (.vtu, .vtk, .mesh, .msh, .node/.ele). Not written when some triangles stay
     /// missing (the exit status is then 1; see --keep-failed).
     #[arg(short, long, value_name = "OUT")]
     output: PathBuf,

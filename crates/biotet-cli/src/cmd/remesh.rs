@@ -34,9 +34,9 @@ interface and the point; crossing an interface is not handled yet.";
 #[derive(clap::Args)]
 #[command(after_help = EXAMPLES)]
 pub struct Args {
-    /// The tet mesh (.vtu, .mesh, .msh, .node/.ele) with its region labels.
+    /// The tet mesh (.vtu, .vtk, .mesh, .msh, .node/.ele) with its region labels.
     mesh: PathBuf,
-    /// Output tet mesh (.vtu, .mesh, .msh, .node/.ele).
+    /// Output tet mesh (.vtu, .vtk, .mesh, .msh, .node/.ele).
     #[arg(short, long, value_name = "OUT")]
     output: PathBuf,
     /// Replace every tet of this region.

@@ -28,7 +28,7 @@ Examples:
 #[derive(clap::Args)]
 #[command(after_help = EXAMPLES)]
 pub struct Args {
-    /// The tet mesh: .vtu, .mesh, .msh, or TetGen .node/.ele.
+    /// The tet mesh: .vtu, .vtk, .mesh, .msh, or TetGen .node/.ele.
     mesh: PathBuf,
     /// The input surface to slide on (repeat for several). Without it, sliding nodes stay on the
     /// mesh's own boundary and interface faces.
@@ -44,7 +44,8 @@ pub struct Args {
     /// Most sweeps over the nodes.
     #[arg(long, value_name = "N", default_value_t = 10)]
     max_sweeps: usize,
-    /// Output tet mesh (.vtu, .mesh, .msh, .node/.ele): same nodes and tets in the same order.
+    /// Output tet mesh (.vtu, .vtk, .mesh, .msh, .node/.ele): same nodes and tets in the same
+    /// order.
     #[arg(short, long, value_name = "OUT")]
     output: PathBuf,
     /// Draw the dihedral- and solid-angle histograms before and after to this SVG.

@@ -34,8 +34,8 @@ Examples:
 pub struct Args {
     #[command(subcommand)]
     command: Option<Sub>,
-    /// Label image: .nii, .nii.gz, .mgh, .mgz, .nrrd, .nhdr, .mha, .mhd, .vti (world
-    /// coordinates RAS+, see docs/formats.md); its labelled surface is written, as `surface extract`.
+    /// Label image: .nii, .nii.gz, .mgh, .mgz, .nrrd, .nhdr, .mha, .mhd, .vti (world coordinates
+    /// RAS+, see docs/formats.md); its labelled surface is written, as `surface extract`.
     #[arg(required = true)]
     image: Option<PathBuf>,
     /// Output labelled surface (.vtu, .ply or .mesh keep the labels on both sides of each
@@ -92,8 +92,8 @@ pub struct ImproveArgs {
     /// Target edge length (default: the input's median edge length).
     #[arg(long, value_name = "L")]
     edge_length: Option<f64>,
-    /// The improved surface (.ply and .vtu keep the region labels of both sides; .mesh the
-    /// labels as references; .stl .obj .off geometry only).
+    /// The improved surface (.ply, .vtu, .vtp and .vtk keep the region labels of both sides; .mesh
+    /// the labels as references; .stl .obj .off geometry only).
     #[arg(short, long, value_name = "OUT")]
     output: Option<PathBuf>,
     #[command(flatten)]

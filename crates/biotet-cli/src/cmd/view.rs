@@ -34,7 +34,7 @@ pub enum View {
 #[derive(clap::Args)]
 #[command(after_help = EXAMPLES)]
 pub struct Args {
-    /// The tet mesh (.vtu, .mesh, .msh, .node/.ele).
+    /// The tet mesh (.vtu, .vtk, .mesh, .msh, .node/.ele).
     mesh: PathBuf,
     /// The picture: .svg or .png.
     #[arg(short, long, value_name = "FILE")]

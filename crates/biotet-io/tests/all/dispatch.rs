@@ -13,6 +13,8 @@ fn kinds_by_extension_and_content() {
         ("a.off", MeshKind::Surface),
         ("a.ply", MeshKind::Surface),
         ("a.vtu", MeshKind::Tetrahedra),
+        ("a.vtp", MeshKind::Surface),
+        ("a.vtk", MeshKind::Tetrahedra),
         ("a.MSH", MeshKind::Tetrahedra),
     ] {
         assert_eq!(mesh_kind(Path::new(n)).unwrap(), k, "{n}");
@@ -27,6 +29,12 @@ fn kinds_by_extension_and_content() {
     biotet_io::write_tet_mesh(&tg, &cube6()).unwrap();
     assert_eq!(mesh_kind(&tet).unwrap(), MeshKind::Tetrahedra);
     assert_eq!(mesh_kind(&surf).unwrap(), MeshKind::Surface);
+    // Legacy VTK holds either: the cells tell.
+    let (tet_vtk, surf_vtk) = (dir.path().join("tet.vtk"), dir.path().join("surf.vtk"));
+    biotet_io::write_tet_mesh(&tet_vtk, &cube6()).unwrap();
+    biotet_io::write_surface(&surf_vtk, &box_surface(1, 1.0)).unwrap();
+    assert_eq!(mesh_kind(&tet_vtk).unwrap(), MeshKind::Tetrahedra);
+    assert_eq!(mesh_kind(&surf_vtk).unwrap(), MeshKind::Surface);
     assert_eq!(mesh_kind(&tri).unwrap(), MeshKind::Triangles2d);
     assert_eq!(mesh_kind(&tg).unwrap(), MeshKind::Tetrahedra);
     assert_eq!(
@@ -45,14 +53,15 @@ fn unknown_extensions_list_the_supported_ones() {
         .to_string();
     assert_eq!(
         e,
-        "foo.xyz: unknown surface file extension; supported: .stl, .obj, .off, .ply, .mesh, .vtu"
+        "foo.xyz: unknown surface file extension; supported: .stl, .obj, .off, .ply, .mesh, .vtu, \
+         .vtp, .vtk"
     );
     let e = biotet_io::write_tet_mesh(Path::new("foo"), &cube6())
         .unwrap_err()
         .to_string();
     assert!(
         e.contains(
-            "unknown tet mesh file extension; supported: .vtu, .mesh, .msh, .node/.ele (TetGen)"
+            "unknown tet mesh file extension; supported: .vtu, .vtk, .mesh, .msh, .node/.ele (TetGen)"
         ),
         "{e}"
     );

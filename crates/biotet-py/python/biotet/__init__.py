@@ -634,8 +634,8 @@ def mesh_file(
 ) -> TetMesh:
     """Mesh what files hold, exactly as ``biotet mesh FILE...`` does (the same tets, byte for
     byte, for the same options): the volume inside the closed surfaces of one or more surface
-    files (STL, OBJ, OFF, PLY, Medit .mesh, VTU), or the regions of one label image (.nii,
-    .nii.gz, .mgh, .mgz, .nrrd, .nhdr, .mha, .mhd, .vti; world coordinates RAS+).
+    files (STL, OBJ, OFF, PLY, Medit .mesh, VTU, VTP, legacy VTK), or the regions of one label
+    image (.nii, .nii.gz, .mgh, .mgz, .nrrd, .nhdr, .mha, .mhd, .vti; world coordinates RAS+).
 
     ``labels`` maps a surface file (as given, or its name) to the labels of its shells, as
     ``--label FILE=N,...``. ``keep_labels``, ``merge``, ``outside`` and
@@ -794,14 +794,17 @@ def smooth(mesh: TetMesh, surface: Surface | tuple[Any, Any] | None = None, *,
                       max_sweeps=max_sweeps, feature_angle=feature_angle, threads=_threads(threads)))
 
 
-_SURFACE_ONLY = (".stl", ".obj", ".off", ".ply")
+_SURFACE_ONLY = (".stl", ".obj", ".off", ".ply", ".vtp")
 
 
 def read(path: PathLike) -> TetMesh | Surface:
     """Read a mesh file: a :class:`TetMesh` when it holds tets (.vtu, .mesh, .msh,
-    .node/.ele), else a :class:`Surface` (STL, OBJ, OFF, PLY, or a .vtu/.mesh of triangles)."""
+    .node/.ele, .vtk), else a :class:`Surface` (STL, OBJ, OFF, PLY, VTP, or a .vtu/.vtk/.mesh
+    of triangles)."""
     p = os.fspath(path)
     if p.lower().endswith(_SURFACE_ONLY):
+        return read_surface(p)
+    if p.lower().endswith(".vtk") and _call(_core.mesh_kind, p) == "surface":
         return read_surface(p)
     m = _tet(_call(_core.read_tet_mesh, p), report=False)
     if m.n_tets == 0 and p.lower().endswith((".vtu", ".mesh")):
@@ -810,7 +813,8 @@ def read(path: PathLike) -> TetMesh | Surface:
 
 
 def read_surface(path: PathLike) -> Surface:
-    """Read a triangle surface file (STL, OBJ, OFF, PLY, Medit, VTU) with its side labels."""
+    """Read a triangle surface file (STL, OBJ, OFF, PLY, Medit, VTU, VTP, legacy VTK) with its
+    side labels."""
     return Surface(*_call(_core.read_surface, os.fspath(path)))
 
 
