@@ -25,19 +25,21 @@ fn io(c: &mut Criterion) {
         .sampling_mode(SamplingMode::Flat)
         .warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(4));
-    let cases: [(&str, Option<TetFormat>); 6] = [
+    let cases: [(&str, Option<TetFormat>); 7] = [
         ("vtu_raw", Some(TetFormat::Vtu)),
         ("vtu_zlib", None),
         ("medit", Some(TetFormat::Medit)),
         ("gmsh41_ascii", Some(TetFormat::Gmsh)),
         ("gmsh41_binary", Some(TetFormat::GmshBinary)),
         ("tetgen", Some(TetFormat::TetGen)),
+        ("vtk_binary", Some(TetFormat::Vtk)),
     ];
     for (name, f) in cases {
         let ext = match f {
             Some(TetFormat::Medit) => "mesh",
             Some(TetFormat::Gmsh | TetFormat::GmshBinary) => "msh",
             Some(TetFormat::TetGen) => "node",
+            Some(TetFormat::Vtk) => "vtk",
             _ => "vtu",
         };
         let path = dir.path().join(format!("{name}.{ext}"));
