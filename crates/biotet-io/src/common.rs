@@ -136,6 +136,30 @@ pub(crate) fn check_surface(m: &SurfaceMesh, file: &str) -> Result<()> {
     check_cells(&m.triangles, m.points.len(), "triangle", file)
 }
 
+/// Validate a surface with its side labels before writing them: one pair a triangle, each label
+/// fitting a signed 32-bit integer (VTK's `Int32`).
+pub(crate) fn check_sided_surface(m: &SurfaceMesh, file: &str) -> Result<()> {
+    check_surface(m, file)?;
+    let nt = m.triangles.len();
+    if m.sides.len() != nt {
+        return Err(Error::invalid(
+            file,
+            format!("{} side-label pairs for {nt} triangles", m.sides.len()),
+        ));
+    }
+    if let Some((t, l)) = m.sides.iter().enumerate().find_map(|(t, s)| {
+        s.iter()
+            .find(|&&l| i32::try_from(l).is_err())
+            .map(|&l| (t, l))
+    }) {
+        return Err(Error::invalid(
+            file,
+            format!("triangle {t}: label {l} does not fit Int32"),
+        ));
+    }
+    Ok(())
+}
+
 /// Validate a tet mesh before writing it.
 pub(crate) fn check_tet(m: &TetMesh, file: &str) -> Result<()> {
     if m.labels.len() != m.tets.len() {

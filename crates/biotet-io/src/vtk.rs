@@ -52,6 +52,7 @@ use crate::common::{
 };
 use crate::error::{Error, Result};
 use crate::text::{Lexer, is_ws, parse_f64, parse_i64, parse_u64, show};
+use crate::vtu::{LABEL_NAMES, SIDE_ARRAYS, SIDE_PAIRS};
 use crate::{MeshKind, SurfaceRead, TetRead};
 
 /// Read a legacy VTK surface from a stream; `file` names it in errors.
@@ -224,7 +225,7 @@ pub fn parse_tet(data: &[u8], file: &str) -> Result<TetRead> {
 
 /// VTK cell types that are volumes: linear, quadratic, higher-order (Lagrange, Bézier),
 /// parametric regions, convex point sets and polyhedra.
-fn is_volume_cell(t: u8) -> bool {
+pub(crate) fn is_volume_cell(t: u8) -> bool {
     matches!(
         t,
         10..=16 | 24..=27 | 29 | 31..=33 | 37 | 41 | 42 | 55 | 56 | 64..=67 | 71..=74 | 78..=81
@@ -241,27 +242,6 @@ fn cell_name(t: u8) -> &'static str {
         _ => "quad",
     }
 }
-
-/// Names of label arrays, in order of preference (as in [`crate::vtu`]).
-const LABEL_NAMES: [&str; 9] = [
-    "region",
-    "gmsh:physical",
-    "medit:ref",
-    "CellEntityIds",
-    "tetgen:ref",
-    "label",
-    "labels",
-    "material",
-    "MaterialIds",
-];
-
-/// Two-component side-label arrays, in order of preference (as in [`crate::vtu`]).
-const SIDE_ARRAYS: [&str; 3] = ["sides", "BoundaryLabels", "boundary_labels"];
-/// Pairs of scalar side-label arrays, `(back, front)`.
-const SIDE_PAIRS: [(&str, &str); 2] = [
-    ("label_back", "label_front"),
-    ("region_back", "region_front"),
-];
 
 /// The label array of a tet mesh: a named one first, else the first integer one.
 fn label_array<'b, 'a>(arrays: &'b [Arr<'a>]) -> Option<&'b Arr<'a>> {

@@ -31,7 +31,7 @@ use std::io::{Read, Write};
 use biotet::quality::tet::{min_dihedral_deg, min_solid_sr, q_measure};
 use biotet::{SurfaceMesh, TetMesh};
 
-use crate::common::{check_surface, check_tet, orient_tets, read_all};
+use crate::common::{check_sided_surface, check_tet, orient_tets, read_all};
 use crate::error::{Error, Result};
 use crate::text::show;
 use crate::vtkxml::{ArrayRef, Ctx, Values};
@@ -168,12 +168,13 @@ pub fn read_tet<R: Read>(r: R, file: &str) -> Result<TetRead> {
     parse_tet(&read_all(r, file)?, file)
 }
 
-/// VTK cell types that are volumes (other than the linear tet, 10).
+/// VTK cell types that are volumes (the list of [`crate::vtk`]).
 pub(crate) fn is_volume_cell(t: i64) -> bool {
-    matches!(t, 10..=16 | 24..=27 | 29 | 32 | 33 | 42 | 71..=74 | 78..=81)
+    u8::try_from(t).is_ok_and(crate::vtk::is_volume_cell)
 }
 
-const LABEL_NAMES: [&str; 9] = [
+/// Names of label arrays, in order of preference (also for legacy VTK).
+pub(crate) const LABEL_NAMES: [&str; 9] = [
     "region",
     "gmsh:physical",
     "medit:ref",
@@ -587,24 +588,8 @@ pub fn parse_surface(data: &[u8], file: &str) -> Result<SurfaceRead> {
 /// Write a surface as VTU (appended raw binary): triangles (VTK type 5) and the cell-data array
 /// `sides` (`Int32`, two components: the regions behind and in front of each triangle).
 pub fn write_surface<W: Write>(w: W, mesh: &SurfaceMesh, file: &str) -> Result<()> {
-    check_surface(mesh, file)?;
+    check_sided_surface(mesh, file)?;
     let nt = mesh.triangles.len();
-    if mesh.sides.len() != nt {
-        return Err(Error::invalid(
-            file,
-            format!("{} side-label pairs for {nt} triangles", mesh.sides.len()),
-        ));
-    }
-    if let Some((t, l)) = mesh.sides.iter().enumerate().find_map(|(t, s)| {
-        s.iter()
-            .find(|&&l| i32::try_from(l).is_err())
-            .map(|&l| (t, l))
-    }) {
-        return Err(Error::invalid(
-            file,
-            format!("triangle {t}: label {l} does not fit Int32"),
-        ));
-    }
     let np = mesh.points.len();
     let wide = np > i32::MAX as usize || 3 * nt > i32::MAX as usize;
     let arrays = [
