@@ -73,7 +73,8 @@ enum Command {
     /// Surfaces: `surface IMAGE -o OUT` extracts the labelled surface of a label image;
     /// `surface improve` remeshes a surface within a distance bound.
     Surface(cmd::surface::Args),
-    /// Validate closed surfaces: closed, manifold, consistently oriented, no self-intersection.
+    /// Validate closed surfaces: closed, manifold, no self-intersection (duplicate points
+    /// welded, turned triangles turned back, both reported).
     Validate(cmd::validate::Args),
     /// Draw a tet mesh as SVG or PNG: the tets a plane cuts, coloured by region or by
     /// quality, or the boundary seen from one viewpoint.

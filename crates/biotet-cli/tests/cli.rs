@@ -305,6 +305,11 @@ fn inward_surface_is_flipped_and_the_user_told() {
         assert!(out.status.success(), "{name}: {}", stderr(&out));
         let want = format!("{n} of the 12 triangles of shell 0 were turned");
         assert!(stderr(&out).contains(&want), "{name}: {}", stderr(&out));
+        let j = json_of(&biotet(&["validate", s(&p), "--json"]));
+        assert_eq!(
+            j["surfaces"][0]["shells"][0]["reoriented"], n,
+            "{name}: {j}"
+        );
         let o = d.path().join("out.vtu");
         let m = biotet(&["mesh", s(&p), "-o", s(&o), "-q"]);
         assert!(m.status.success(), "{name}: {}", stderr(&m));

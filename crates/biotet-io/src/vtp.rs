@@ -8,7 +8,8 @@
 //! VTU surface (a two-component `sides`, `BoundaryLabels` or `boundary_labels`, or the scalar
 //! pairs `label_back`/`label_front` and `region_back`/`region_front`). Cell data covers every
 //! cell in VTK's order — vertices, lines, polygons, strips — so a polygon's values sit past the
-//! piece's vertices and lines.
+//! piece's vertices and lines. Errors number a polygon or strip among its kind (as the offsets
+//! do) and say which kind.
 //!
 //! Writing ([`write_surface`]): appended raw binary, `Float64` points, the triangles as
 //! polygons and the cell-data array `sides` (`Int32`, two components), as [`crate::vtu`] writes
@@ -206,7 +207,11 @@ pub fn parse_surface(data: &[u8], file: &str) -> Result<SurfaceRead> {
             if cells.n == 0 {
                 continue;
             }
-            let name = if kind == POLYS { "Polys" } else { "Strips" };
+            let (name, word) = if kind == POLYS {
+                ("Polys", "polygon")
+            } else {
+                ("Strips", "triangle strip")
+            };
             let (offsets, conn) = read_cells(&ctx, cells, name, pi)?;
             let mut prev = 0usize;
             for i in 0..cells.n {
@@ -215,8 +220,8 @@ pub fn parse_surface(data: &[u8], file: &str) -> Result<SurfaceRead> {
                     return Err(Error::element(
                         file,
                         "cell",
-                        cell,
-                        format!("a {} with {} points", &name[..name.len() - 1], c.len()),
+                        i,
+                        format!("a {word} with {} points", c.len()),
                     ));
                 }
                 let side = match &labels {
@@ -227,8 +232,8 @@ pub fn parse_surface(data: &[u8], file: &str) -> Result<SurfaceRead> {
                                 Error::element(
                                     file,
                                     "cell",
-                                    cell,
-                                    format!("array '{}': {e}", show(n)),
+                                    i,
+                                    format!("a {word}'s array '{}': {e}", show(n)),
                                 )
                             })
                         };

@@ -21,8 +21,9 @@ Examples:
 pub struct Args {
     /// Input mesh; its format is chosen by extension.
     input: PathBuf,
-    /// Output mesh; its format is chosen by extension (.vtu .vtk .mesh .msh .node/.ele for tets and
-    /// 2D triangles; .stl .obj .off .ply .mesh .vtu .vtp .vtk for surfaces).
+    /// Output mesh; its format is chosen by extension (.vtu .vtk .mesh .msh .node/.ele for tets;
+    /// .vtu .mesh .msh .node/.ele for 2D triangles; .stl .obj .off .ply .mesh .vtu .vtp .vtk for
+    /// surfaces).
     #[arg(short, long, value_name = "OUT")]
     output: PathBuf,
     /// For a surface: label its regions as `biotet mesh` does (closed shells nested innermost
@@ -49,13 +50,13 @@ pub fn run(a: Args) -> Result<ExitCode> {
     if surface_ext && kind != MeshKind::Surface {
         anyhow::bail!(
             "{}: cannot write a volume or 2D mesh as a surface (.{out_ext}); \
-             use .vtu, .vtk, .mesh, .msh or .node/.ele",
+             use .vtu, .mesh, .msh or .node/.ele (tets also .vtk)",
             a.output.display()
         );
     }
     if kind == MeshKind::Surface && ["msh", "node", "ele"].contains(&out_ext.as_str()) {
         anyhow::bail!(
-            "{}: {} is a surface; write it as .stl, .obj, .off, .ply, .mesh, .vtu or .vtp \
+            "{}: {} is a surface; write it as .stl, .obj, .off, .ply, .mesh, .vtu, .vtp or .vtk \
              (meshing a surface is `biotet mesh`, coming with the mesher)",
             a.output.display(),
             a.input.display()

@@ -147,8 +147,8 @@ pub struct Args {
     /// Label image: .nii, .nii.gz, .mgh, .mgz, .nrrd, .nhdr, .mha, .mhd, .vti (world
     /// coordinates RAS+, see docs/formats.md).
     pub(crate) image: PathBuf,
-    /// Output labelled surface (.vtu, .ply or .mesh keep the labels on both sides of each
-    /// triangle).
+    /// Output labelled surface (.vtu, .vtp, .vtk, .ply or .mesh keep the labels on both sides of
+    /// each triangle).
     #[arg(short, long, value_name = "OUT")]
     pub(crate) output: Option<PathBuf>,
     #[command(flatten)]

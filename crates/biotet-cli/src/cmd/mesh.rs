@@ -151,8 +151,8 @@ pub struct Args {
     /// staircase). A surface input is kept exactly anyway unless --surface-tolerance is given.
     #[arg(long, conflicts_with = "surface_tolerance")]
     exact_surface: bool,
-    /// Write the surface that was meshed here (after the surface stage, if it ran; .ply and
-    /// .vtu keep the region labels).
+    /// Write the surface that was meshed here (after the surface stage, if it ran; .ply, .vtu,
+    /// .vtp and .vtk keep the region labels).
     #[arg(long, value_name = "FILE")]
     surface_output: Option<PathBuf>,
     #[command(flatten)]

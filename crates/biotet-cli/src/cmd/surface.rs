@@ -38,8 +38,8 @@ pub struct Args {
     /// RAS+, see docs/formats.md); its labelled surface is written, as `surface extract`.
     #[arg(required = true)]
     image: Option<PathBuf>,
-    /// Output labelled surface (.vtu, .ply or .mesh keep the labels on both sides of each
-    /// triangle).
+    /// Output labelled surface (.vtu, .vtp, .vtk, .ply or .mesh keep the labels on both sides of
+    /// each triangle).
     #[arg(short, long, value_name = "OUT")]
     output: Option<PathBuf>,
     #[command(flatten)]

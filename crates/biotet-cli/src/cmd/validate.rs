@@ -31,7 +31,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
     let mut out = Vec::new();
     for path in &a.surfaces {
         let stage = Stage::start(a.common.quiet, format!("validating {}", path.display()));
-        let (mesh, _, report, _) = super::input::labelled_surface_report(
+        let (mesh, shells, report, _) = super::input::labelled_surface_report(
             std::slice::from_ref(path),
             &[],
             a.common,
@@ -52,7 +52,8 @@ pub fn run(a: Args) -> Result<ExitCode> {
                 }
             ));
         }
-        out.push(json!({"file": path, "report": report}));
+        // The shells say what was repaired (triangles turned back, shells flipped outward).
+        out.push(json!({"file": path, "report": report, "shells": shells}));
     }
     if a.common.json {
         crate::emit(&serde_json::to_string_pretty(&json!({"surfaces": out}))?);

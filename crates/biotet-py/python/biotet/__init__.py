@@ -245,7 +245,7 @@ class TetMesh:
         return int(self.tets.shape[0])
 
     def write(self, path: PathLike) -> list[str]:
-        """Write the mesh (format from the extension: .vtu, .mesh, .msh, .node/.ele); the file
+        """Write the mesh (format from the extension: .vtu, .vtk, .mesh, .msh, .node/.ele); the file
         appears whole or not at all. Returns the paths written."""
         return write(path, self)
 
@@ -819,7 +819,7 @@ def read_surface(path: PathLike) -> Surface:
 
 
 def write(path: PathLike, mesh: TetMesh) -> list[str]:
-    """Write a tet mesh (format from the extension: .vtu, .mesh, .msh, .node/.ele) through a
+    """Write a tet mesh (format from the extension: .vtu, .vtk, .mesh, .msh, .node/.ele) through a
     temporary file renamed into place. Returns the paths written."""
     out = _call(_core.write_tet_mesh, os.fspath(path), *_mesh_arrays(mesh))
     return [os.fspath(p) for p in out]

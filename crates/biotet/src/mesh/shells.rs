@@ -1,9 +1,10 @@
 //! Several closed surfaces to one labelled surface: each closed shell encloses a region, and the
 //! region of a point is the label of the innermost shell containing it.
 //!
-//! Shells are the connected components of the input triangles (through shared edges), after
-//! the parts' points are welded (exactly equal coordinates are one point, so a triangle soup is
-//! the surface it describes). Each is
+//! Shells are the connected components of the input triangles (through shared edges); a part
+//! with an edge open in its own numbering (a triangle soup) is first welded (exactly equal
+//! coordinates are one point), so a soup is the surface it describes. Within each shell,
+//! triangles turned against their neighbours are turned back (the minority orientation). Each is
 //! oriented outward on its own (by its signed volume), then nested by exact point location
 //! ([`RegionLocator`]). A shell's triangles get `sides = [own label, label of the shell around
 //! it]` (0 when none). Two sibling shells that share triangles (touching tissues) keep one copy
@@ -97,7 +98,8 @@ pub enum AssembleError {
 /// An input part: a surface and optional labels for its shells in order (default: the next
 /// unused labels 1, 2, … in order of parts and shells).
 pub struct Part {
-    /// The triangles (any orientation per shell, consistent within a shell).
+    /// The triangles (any orientation per shell; within a shell, the minority orientation is
+    /// turned to the majority's).
     pub surface: SurfaceMesh,
     /// Labels of its shells in order of first triangle.
     pub labels: Option<Vec<u32>>,
@@ -135,9 +137,10 @@ fn components(tris: &[[u32; 3]]) -> (Vec<u32>, usize) {
 
 /// Turn the triangles of one shell (connected through edges, at most two triangles an edge) that
 /// disagree with their neighbours: each edge then traversed once each way. The orientation of
-/// the shell's first triangle spreads through shared edges, and the smaller class is turned (the
-/// given one on a tie); the number turned. A shell where the spread meets itself turned (not
-/// orientable, or an edge of more than two triangles) is left as given: 0.
+/// the shell's first triangle spreads through shared edges, and the smaller class is turned (on
+/// a tie, those disagreeing with the first triangle); the number turned. A shell where the
+/// spread meets itself turned (not orientable, or an edge of more than two triangles) is left as
+/// given: 0.
 fn orient_consistently(tris: &mut [[u32; 3]]) -> usize {
     let n = tris.len();
     // The (at most two) triangles of each edge.
@@ -219,6 +222,18 @@ fn alone(points: &[[f64; 3]], tris: &[[u32; 3]]) -> SurfaceMesh {
         })
         .collect();
     SurfaceMesh::closed(pts, tris, 1)
+}
+
+/// Whether some edge has only one triangle.
+fn has_open_edge(tris: &[[u32; 3]]) -> bool {
+    let mut count: FxHashMap<(u32, u32), u32> = Default::default();
+    for t in tris {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            *count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+        }
+    }
+    count.values().any(|&c| c == 1)
 }
 
 /// Whether some edge has more than two triangles.
@@ -357,14 +372,14 @@ pub fn label_arrangement(
     ))
 }
 
-/// Assemble parts into one surface with region labels; returns it and its shells.
+/// Assemble parts into one surface with region labels; returns it and its shells (see the
+/// module docs: soups welded, shells nested, turned triangles turned back, shared triangles one
+/// interface).
 pub fn assemble(parts: Vec<Part>) -> Result<(SurfaceMesh, Vec<Shell>), AssembleError> {
-    // One welded point set, before shells are found: copies of a point that differ only by
-    // index (a triangle soup, as a PLY or OBJ written without merging points) are one point,
-    // else each triangle of a soup is a shell of its own.
+    // One welded point set for the geometry.
     let mut points: Vec<[f64; 3]> = Vec::new();
     let mut index: FxHashMap<[u64; 3], u32> = Default::default();
-    let part_tris: Vec<Vec<[u32; 3]>> = parts
+    let welded: Vec<Vec<[u32; 3]>> = parts
         .iter()
         .map(|part| {
             let map: Vec<u32> = part
@@ -382,22 +397,37 @@ pub fn assemble(parts: Vec<Part>) -> Result<(SurfaceMesh, Vec<Shell>), AssembleE
             tris.iter().map(|t| t.map(|v| map[v as usize])).collect()
         })
         .collect();
+    // The topology a part's shells are found in: its own indices when they close every edge
+    // (shells that touch, each with its own copies of the shared points, stay apart and share
+    // an interface); the welded indices when some edge is open in its own (a triangle soup, as
+    // a PLY or OBJ written without merging points, where each triangle would be a shell).
+    let joined: Vec<bool> = parts
+        .iter()
+        .map(|p| has_open_edge(&p.surface.triangles))
+        .collect();
+    let topo = |k: usize| -> &[[u32; 3]] {
+        if joined[k] {
+            &welded[k]
+        } else {
+            &parts[k].surface.triangles
+        }
+    };
     // A triangle whose corners welded together (distinct points in the file at one position)
     // is left to the validation, which names it; the arrangement would only see bad edges.
     let collapsed = |tris: &[[u32; 3]]| {
         tris.iter()
             .any(|t| t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
     };
-    if let Some(k) = part_tris
-        .iter()
-        .position(|t| is_non_manifold(t) && !collapsed(t))
-    {
+    if let Some(k) = (0..parts.len()).find(|&k| is_non_manifold(topo(k)) && !collapsed(topo(k))) {
         if parts.len() > 1 {
             return Err(AssembleError::NonManifoldWithOthers);
         }
+        if !joined[k] {
+            return label_arrangement(&parts[k].surface, parts[k].labels.as_deref());
+        }
         let s = SurfaceMesh {
             points,
-            triangles: part_tris[k].clone(),
+            triangles: welded[k].clone(),
             sides: parts[k].surface.sides.clone(),
         };
         return label_arrangement(&s, parts[k].labels.as_deref());
@@ -406,8 +436,8 @@ pub fn assemble(parts: Vec<Part>) -> Result<(SurfaceMesh, Vec<Shell>), AssembleE
     let mut shell_tris: Vec<Vec<[u32; 3]>> = Vec::new();
     let mut shells: Vec<Shell> = Vec::new();
     let mut next_label = 1u32;
-    for (pi, (part, tris)) in parts.iter().zip(&part_tris).enumerate() {
-        let (comp, n) = components(tris);
+    for (pi, (part, tris)) in parts.iter().zip(&welded).enumerate() {
+        let (comp, n) = components(topo(pi));
         if let Some(l) = &part.labels
             && l.len() != n
         {

@@ -350,6 +350,14 @@ fn a_triangle_soup_assembles_as_its_welded_surface() {
     assert_eq!(s.points.len(), 14);
     validate_surface(&mut s, &ValidateOptions::default()).unwrap();
     assert_eq!(touching(&s).edges.len(), 1);
+    // Two cubes sharing a face in one part, each on its own copies of the shared points (each
+    // closed in the file's numbering): two shells and one interface, as before any welding.
+    let mut pair = cube_surface([0.0; 3], 1.0);
+    pair.append(&cube_surface([1.0, 0.0, 0.0], 1.0));
+    let (mut s, shells) = assemble(vec![part(pair, None)]).unwrap();
+    assert_eq!(shells.len(), 2);
+    assert_eq!(s.sides.iter().filter(|x| x[0] != 0 && x[1] != 0).count(), 2);
+    validate_surface(&mut s, &ValidateOptions::default()).unwrap();
     // A soup whose points collapse (two corners of a triangle at one position) is left to the
     // validation, which names the triangle.
     let mut flat = soup(&outer);
