@@ -274,3 +274,24 @@ pub(crate) fn face_groups(m: &TetMesh) -> FaceGroups {
         group_of,
     }
 }
+
+/// The triangles of polygon `c` (three corners or more) fanned from its first corner; a polygon
+/// of more than three corners counts in `split`.
+pub(crate) fn fan<'c>(c: &'c [u32], split: &mut usize) -> impl Iterator<Item = [u32; 3]> + 'c {
+    if c.len() > 3 {
+        *split += 1;
+    }
+    (1..c.len().saturating_sub(1)).map(move |k| [c[0], c[k], c[k + 1]])
+}
+
+/// The triangles of triangle strip `c`: triangle `j` is `j, j+1, j+2`, its first two corners
+/// swapped for odd `j` so that all keep the strip's orientation.
+pub(crate) fn strip(c: &[u32]) -> impl Iterator<Item = [u32; 3]> + '_ {
+    (0..c.len().saturating_sub(2)).map(move |j| {
+        if j % 2 == 0 {
+            [c[j], c[j + 1], c[j + 2]]
+        } else {
+            [c[j + 1], c[j], c[j + 2]]
+        }
+    })
+}

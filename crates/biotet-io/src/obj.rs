@@ -76,12 +76,9 @@ pub fn parse(data: &[u8], file: &str) -> Result<SurfaceRead> {
                         corners.len()
                     )));
                 }
-                if corners.len() > 3 {
-                    split += 1;
-                }
                 let line = lx.tok_line.min(u32::MAX as usize) as u32;
-                for k in 1..corners.len() - 1 {
-                    triangles.push([corners[0], corners[k], corners[k + 1]]);
+                for t in crate::common::fan(&corners, &mut split) {
+                    triangles.push(t);
                     tri_line.push(line);
                 }
             }

@@ -416,11 +416,8 @@ pub fn parse(data: &[u8], file: &str) -> Result<SurfaceRead> {
                 }
                 points.push(p);
             } else if is_face {
-                if corners.len() > 3 {
-                    split += 1;
-                }
-                for k in 1..corners.len() - 1 {
-                    triangles.push([corners[0], corners[k], corners[k + 1]]);
+                for t in crate::common::fan(&corners, &mut split) {
+                    triangles.push(t);
                     if has_refs {
                         refs.push(refv);
                     }

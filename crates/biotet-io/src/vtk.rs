@@ -359,11 +359,8 @@ impl Tris {
                 format!("a polygon with {} corners", c.len()),
             ));
         }
-        if c.len() > 3 {
-            self.split += 1;
-        }
-        for k in 1..c.len() - 1 {
-            self.triangles.push([c[0], c[k], c[k + 1]]);
+        for t in crate::common::fan(c, &mut self.split) {
+            self.triangles.push(t);
             self.sides.push(side);
         }
         Ok(())
@@ -387,12 +384,7 @@ impl Tris {
                 format!("a triangle strip with {} points", c.len()),
             ));
         }
-        for j in 0..c.len() - 2 {
-            let t = if j % 2 == 0 {
-                [c[j], c[j + 1], c[j + 2]]
-            } else {
-                [c[j + 1], c[j], c[j + 2]]
-            };
+        for t in crate::common::strip(c) {
             self.triangles.push(t);
             self.sides.push(side);
         }

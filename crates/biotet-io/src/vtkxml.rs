@@ -655,3 +655,83 @@ impl<'a> Ctx<'a> {
         self.app_offsets.dedup();
     }
 }
+
+/// Walk the pieces of a VTK XML file of type `kind` (`ext` for messages). `open` makes a piece
+/// from its `Piece` tag's numbers (`num(name, required)`: an attribute absent and not required
+/// is 0); `array` files each `DataArray` of a piece under the element of `sections` it sits in
+/// (`Points`, `Cells`, `CellData`, …; empty outside them). Returns the context to decode the
+/// arrays with, and the pieces in file order.
+pub(crate) fn read_pieces<'a, P>(
+    data: &'a [u8],
+    file: &'a str,
+    (kind, ext): (&str, &str),
+    sections: &[&[u8]],
+    open: impl Fn(&dyn Fn(&str, bool) -> Result<usize>) -> Result<P>,
+    array: impl Fn(&mut P, &[u8], ArrayRef<'a>),
+) -> Result<(Ctx<'a>, Vec<P>)> {
+    let (mut ctx, xml_end) = Ctx::new(data, file)?;
+    let xml = &data[..xml_end];
+    let mut pos = 0;
+    let mut pieces: Vec<P> = Vec::new();
+    let mut cur: Option<P> = None;
+    let mut section: &[u8] = b"";
+    let mut seen_root = false;
+    while let Some(tag) = ctx.next_tag(xml, &mut pos)? {
+        match tag.name {
+            b"VTKFile" if !tag.closing => {
+                seen_root = true;
+                ctx.root(&tag, kind, ext)?;
+            }
+            b"Piece" if !tag.closing => {
+                if !seen_root {
+                    return Err(ctx.err_at(tag.start, "Piece outside VTKFile"));
+                }
+                let num = |k: &str, required: bool| -> Result<usize> {
+                    match tag.attr(k) {
+                        None if !required => Ok(0),
+                        None => Err(ctx.err_at(tag.start, format!("Piece without {k}"))),
+                        Some(v) => crate::text::parse_u64(v)
+                            .and_then(|x| usize::try_from(x).ok())
+                            .ok_or_else(|| ctx.err_at(tag.start, format!("bad {k} '{}'", show(v)))),
+                    }
+                };
+                let p = open(&num)?;
+                if tag.self_closing {
+                    pieces.push(p);
+                } else {
+                    cur = Some(p);
+                }
+            }
+            b"Piece" => {
+                if let Some(p) = cur.take() {
+                    pieces.push(p);
+                }
+            }
+            name if sections.contains(&name) => {
+                section = if tag.closing || tag.self_closing {
+                    b""
+                } else {
+                    name
+                };
+            }
+            b"DataArray" if !tag.closing => {
+                let a = ctx.data_array(&tag, xml, &mut pos)?;
+                if let Some(p) = cur.as_mut() {
+                    array(p, section, a);
+                }
+            }
+            _ => {}
+        }
+    }
+    if !seen_root {
+        return Err(Error::format(
+            file,
+            "no VTKFile element: not a VTK XML file",
+        ));
+    }
+    if let Some(p) = cur.take() {
+        pieces.push(p);
+    }
+    ctx.end_of_xml();
+    Ok((ctx, pieces))
+}

@@ -25,8 +25,7 @@ use crate::error::{Error, Result};
 use crate::text::show;
 use crate::vtkxml::{ArrayRef, Ctx};
 use crate::vtu::{
-    SIDE_ARRAYS, SIDE_PAIRS, VtuEncoding, cell_points, cells_connectivity, cells_offsets,
-    read_points,
+    VtuEncoding, cell_points, cells_connectivity, cells_offsets, read_points, side_arrays,
 };
 use crate::vtu_out::{self, Array, Data, Grid, Ty};
 
@@ -59,89 +58,45 @@ const STRIPS: usize = 3;
 
 /// The pieces of a VTP file, with the context to decode their arrays.
 fn read_pieces<'a>(data: &'a [u8], file: &'a str) -> Result<(Ctx<'a>, Vec<Piece<'a>>)> {
-    let (mut ctx, xml_end) = Ctx::new(data, file)?;
-    let xml = &data[..xml_end];
-    let mut pos = 0;
-    let mut pieces: Vec<Piece> = Vec::new();
-    let mut cur: Option<Piece> = None;
-    let mut section: &[u8] = b"";
-    let mut seen_root = false;
-    while let Some(tag) = ctx.next_tag(xml, &mut pos)? {
-        match tag.name {
-            b"VTKFile" if !tag.closing => {
-                seen_root = true;
-                ctx.root(&tag, "PolyData", ".vtp")?;
+    crate::vtkxml::read_pieces(
+        data,
+        file,
+        ("PolyData", ".vtp"),
+        &[
+            b"Points",
+            b"Verts",
+            b"Lines",
+            b"Polys",
+            b"Strips",
+            b"CellData",
+            b"PointData",
+            b"FieldData",
+        ],
+        |num| {
+            // Counts absent from the tag are zero (VTK writes only what it has).
+            let mut p = Piece {
+                npts: num("NumberOfPoints", true)?,
+                ..Piece::default()
+            };
+            for (k, (_, attr)) in KINDS.iter().enumerate() {
+                p.cells[k].n = num(attr, false)?;
             }
-            b"Piece" if !tag.closing => {
-                if !seen_root {
-                    return Err(ctx.err_at(tag.start, "Piece outside VTKFile"));
-                }
-                // Counts absent from the tag are zero (VTK writes only what it has).
-                let num = |k: &str, required: bool| -> Result<usize> {
-                    match tag.attr(k) {
-                        None if !required => Ok(0),
-                        None => Err(ctx.err_at(tag.start, format!("Piece without {k}"))),
-                        Some(v) => crate::text::parse_u64(v)
-                            .and_then(|x| usize::try_from(x).ok())
-                            .ok_or_else(|| ctx.err_at(tag.start, format!("bad {k} '{}'", show(v)))),
-                    }
-                };
-                let mut p = Piece {
-                    npts: num("NumberOfPoints", true)?,
-                    ..Piece::default()
-                };
-                for (k, (_, attr)) in KINDS.iter().enumerate() {
-                    p.cells[k].n = num(attr, false)?;
-                }
-                if tag.self_closing {
-                    pieces.push(p);
-                } else {
-                    cur = Some(p);
+            Ok(p)
+        },
+        |p, section, a| {
+            if section == b"Points" {
+                p.points.get_or_insert(a);
+            } else if section == b"CellData" {
+                p.cell_data.push(a);
+            } else if let Some(k) = KINDS.iter().position(|(s, _)| *s == section) {
+                match a.name {
+                    b"connectivity" => p.cells[k].conn = Some(a),
+                    b"offsets" => p.cells[k].offsets = Some(a),
+                    _ => {}
                 }
             }
-            b"Piece" => {
-                if let Some(p) = cur.take() {
-                    pieces.push(p);
-                }
-            }
-            b"Points" | b"Verts" | b"Lines" | b"Polys" | b"Strips" | b"CellData" | b"PointData"
-            | b"FieldData" => {
-                section = if tag.closing || tag.self_closing {
-                    b""
-                } else {
-                    tag.name
-                };
-            }
-            b"DataArray" if !tag.closing => {
-                let a = ctx.data_array(&tag, xml, &mut pos)?;
-                if let Some(p) = cur.as_mut() {
-                    if section == b"Points" {
-                        p.points.get_or_insert(a);
-                    } else if section == b"CellData" {
-                        p.cell_data.push(a);
-                    } else if let Some(k) = KINDS.iter().position(|(s, _)| *s == section) {
-                        match a.name {
-                            b"connectivity" => p.cells[k].conn = Some(a),
-                            b"offsets" => p.cells[k].offsets = Some(a),
-                            _ => {}
-                        }
-                    }
-                }
-            }
-            _ => {}
-        }
-    }
-    if !seen_root {
-        return Err(Error::format(
-            file,
-            "no VTKFile element: not a VTK XML file",
-        ));
-    }
-    if let Some(p) = cur.take() {
-        pieces.push(p);
-    }
-    ctx.end_of_xml();
-    Ok((ctx, pieces))
+        },
+    )
 }
 
 /// The offsets and connectivity of one kind of cells of piece `pi`, decoded.
@@ -188,7 +143,7 @@ pub fn parse_surface(data: &[u8], file: &str) -> Result<SurfaceRead> {
             .iter()
             .try_fold(0usize, |a, k| a.checked_add(k.n))
             .ok_or_else(|| Error::format(file, format!("piece {pi}: too many cells")))?;
-        let labels = side_arrays(&ctx, p, ncells)?;
+        let labels = side_arrays(&ctx, &p.cell_data, ncells)?;
         if p.cells[POLYS].n + p.cells[STRIPS].n > 0 {
             if let Some(prev) = labelled
                 && prev != labels.is_some()
@@ -242,21 +197,12 @@ pub fn parse_surface(data: &[u8], file: &str) -> Result<SurfaceRead> {
                     None => [1, 0],
                 };
                 if kind == POLYS {
-                    if c.len() > 3 {
-                        split += 1;
-                    }
-                    for k in 1..c.len() - 1 {
-                        triangles.push([c[0], c[k], c[k + 1]]);
+                    for t in crate::common::fan(&c, &mut split) {
+                        triangles.push(t);
                         sides.push(side);
                     }
                 } else {
-                    // Triangle j of a strip is (j, j+1, j+2), turned on odd j: one orientation.
-                    for j in 0..c.len() - 2 {
-                        let t = if j % 2 == 0 {
-                            [c[j], c[j + 1], c[j + 2]]
-                        } else {
-                            [c[j + 1], c[j], c[j + 2]]
-                        };
+                    for t in crate::common::strip(&c) {
                         triangles.push(t);
                         sides.push(side);
                     }
@@ -273,37 +219,6 @@ pub fn parse_surface(data: &[u8], file: &str) -> Result<SurfaceRead> {
         welded: 0,
         polygons_split: split,
     })
-}
-
-/// The side-label arrays of a piece of `ncells` cells (all kinds): the array name(s), then the
-/// back and front values per cell.
-type SideArrays<'a> = (Vec<&'a [u8]>, Vec<i64>, Vec<i64>);
-
-fn side_arrays<'a>(ctx: &Ctx, p: &Piece<'a>, ncells: usize) -> Result<Option<SideArrays<'a>>> {
-    let find = |n: &str, ncomp: usize| {
-        p.cell_data
-            .iter()
-            .find(|a| a.name == n.as_bytes() && a.ncomp == ncomp && !a.ty.is_float())
-    };
-    if let Some(a) = SIDE_ARRAYS.iter().find_map(|n| find(n, 2)) {
-        let cap = ncells
-            .checked_mul(2)
-            .ok_or_else(|| Error::format(ctx.file, "too many cells"))?;
-        let v = ctx.ints(a, Some(cap))?;
-        let (b, f) = v.chunks_exact(2).map(|x| (x[0], x[1])).unzip();
-        return Ok(Some((vec![a.name], b, f)));
-    }
-    if let Some((b, f)) = SIDE_PAIRS
-        .iter()
-        .find_map(|(b, f)| Some((find(b, 1)?, find(f, 1)?)))
-    {
-        return Ok(Some((
-            vec![b.name, f.name],
-            ctx.ints(b, Some(ncells))?,
-            ctx.ints(f, Some(ncells))?,
-        )));
-    }
-    Ok(None)
 }
 
 /// Write a surface as VTP (appended raw binary): the triangles as polygons and the cell-data

@@ -188,84 +188,30 @@ pub(crate) const LABEL_NAMES: [&str; 9] = [
 
 /// The pieces of a VTU file, with the context to decode their arrays.
 fn read_pieces<'a>(data: &'a [u8], file: &'a str) -> Result<(Ctx<'a>, Vec<Piece<'a>>)> {
-    let (mut ctx, xml_end) = Ctx::new(data, file)?;
-    let xml = &data[..xml_end];
-    let mut pos = 0;
-    let mut pieces: Vec<Piece> = Vec::new();
-    let mut cur: Option<Piece> = None;
-    let mut section: &[u8] = b"";
-    let mut seen_root = false;
-    while let Some(tag) = ctx.next_tag(xml, &mut pos)? {
-        match tag.name {
-            b"VTKFile" if !tag.closing => {
-                seen_root = true;
-                ctx.root(&tag, "UnstructuredGrid", ".vtu")?;
-            }
-            b"Piece" if !tag.closing => {
-                if !seen_root {
-                    return Err(ctx.err_at(tag.start, "Piece outside VTKFile"));
-                }
-                let num = |k: &str| -> Result<usize> {
-                    let v = tag
-                        .attr(k)
-                        .ok_or_else(|| ctx.err_at(tag.start, format!("Piece without {k}")))?;
-                    crate::text::parse_u64(v)
-                        .and_then(|x| usize::try_from(x).ok())
-                        .ok_or_else(|| ctx.err_at(tag.start, format!("bad {k} '{}'", show(v))))
-                };
-                let p = Piece {
-                    npts: num("NumberOfPoints")?,
-                    ncells: num("NumberOfCells")?,
-                    ..Piece::default()
-                };
-                if tag.self_closing {
-                    pieces.push(p);
-                } else {
-                    cur = Some(p);
-                }
-            }
-            b"Piece" => {
-                if let Some(p) = cur.take() {
-                    pieces.push(p);
-                }
-            }
-            b"Points" | b"Cells" | b"CellData" | b"PointData" | b"FieldData" => {
-                section = if tag.closing || tag.self_closing {
-                    b""
-                } else {
-                    tag.name
-                };
-            }
-            b"DataArray" if !tag.closing => {
-                let a = ctx.data_array(&tag, xml, &mut pos)?;
-                if let Some(p) = cur.as_mut() {
-                    match section {
-                        b"Points" if p.points.is_none() => p.points = Some(a),
-                        b"Cells" => match a.name {
-                            b"connectivity" => p.conn = Some(a),
-                            b"offsets" => p.offsets = Some(a),
-                            b"types" => p.types = Some(a),
-                            _ => {}
-                        },
-                        b"CellData" => p.cell_data.push(a),
-                        _ => {}
-                    }
-                }
-            }
+    crate::vtkxml::read_pieces(
+        data,
+        file,
+        ("UnstructuredGrid", ".vtu"),
+        &[b"Points", b"Cells", b"CellData", b"PointData", b"FieldData"],
+        |num| {
+            Ok(Piece {
+                npts: num("NumberOfPoints", true)?,
+                ncells: num("NumberOfCells", true)?,
+                ..Piece::default()
+            })
+        },
+        |p, section, a| match section {
+            b"Points" if p.points.is_none() => p.points = Some(a),
+            b"Cells" => match a.name {
+                b"connectivity" => p.conn = Some(a),
+                b"offsets" => p.offsets = Some(a),
+                b"types" => p.types = Some(a),
+                _ => {}
+            },
+            b"CellData" => p.cell_data.push(a),
             _ => {}
-        }
-    }
-    if !seen_root {
-        return Err(Error::format(
-            file,
-            "no VTKFile element: not a VTK XML file",
-        ));
-    }
-    if let Some(p) = cur.take() {
-        pieces.push(p);
-    }
-    ctx.end_of_xml();
-    Ok((ctx, pieces))
+        },
+    )
 }
 
 /// Append the points of piece `pi` to `points`.
@@ -450,7 +396,41 @@ pub(crate) const SIDE_PAIRS: [(&str, &str); 2] = [
 ];
 
 /// Side labels of a piece's cells: the array name(s), then back and front values per cell.
-type SideArrays<'a> = (Vec<&'a [u8]>, Vec<i64>, Vec<i64>);
+pub(crate) type SideArrays<'a> = (Vec<&'a [u8]>, Vec<i64>, Vec<i64>);
+
+/// The side labels among the cell data `cell_data` of a piece of `ncells` cells (every kind of
+/// cell, in the order VTK numbers them): a two-component array of [`SIDE_ARRAYS`], else a scalar
+/// pair of [`SIDE_PAIRS`], integer-typed; `None` when there is none.
+pub(crate) fn side_arrays<'a>(
+    ctx: &Ctx,
+    cell_data: &[ArrayRef<'a>],
+    ncells: usize,
+) -> Result<Option<SideArrays<'a>>> {
+    let find = |n: &str, ncomp: usize| {
+        cell_data
+            .iter()
+            .find(|a| a.name == n.as_bytes() && a.ncomp == ncomp && !a.ty.is_float())
+    };
+    if let Some(a) = SIDE_ARRAYS.iter().find_map(|n| find(n, 2)) {
+        let cap = ncells
+            .checked_mul(2)
+            .ok_or_else(|| Error::format(ctx.file, "too many cells"))?;
+        let v = ctx.ints(a, Some(cap))?;
+        let (b, f) = v.chunks_exact(2).map(|x| (x[0], x[1])).unzip();
+        return Ok(Some((vec![a.name], b, f)));
+    }
+    if let Some((b, f)) = SIDE_PAIRS
+        .iter()
+        .find_map(|(b, f)| Some((find(b, 1)?, find(f, 1)?)))
+    {
+        return Ok(Some((
+            vec![b.name, f.name],
+            ctx.ints(b, Some(ncells))?,
+            ctx.ints(f, Some(ncells))?,
+        )));
+    }
+    Ok(None)
+}
 
 /// What a VTU file holds: [`MeshKind::Tetrahedra`] when it has a volume cell (or no surface
 /// cell), else [`MeshKind::Surface`]. Decodes only the cell types.
@@ -499,26 +479,7 @@ pub fn parse_surface(data: &[u8], file: &str) -> Result<SurfaceRead> {
             continue;
         }
         let (offsets, types, conn) = read_cells(&ctx, p, pi)?;
-        let find = |n: &str, ncomp: usize| {
-            p.cell_data
-                .iter()
-                .find(|a| a.name == n.as_bytes() && a.ncomp == ncomp && !a.ty.is_float())
-        };
-        let mut lab: Option<SideArrays> = None;
-        if let Some(a) = SIDE_ARRAYS.iter().find_map(|n| find(n, 2)) {
-            let v = ctx.ints(a, Some(2 * p.ncells))?;
-            let (b, f) = v.chunks_exact(2).map(|x| (x[0], x[1])).unzip();
-            lab = Some((vec![a.name], b, f));
-        } else if let Some((b, f)) = SIDE_PAIRS
-            .iter()
-            .find_map(|(b, f)| Some((find(b, 1)?, find(f, 1)?)))
-        {
-            lab = Some((
-                vec![b.name, f.name],
-                ctx.ints(b, Some(p.ncells))?,
-                ctx.ints(f, Some(p.ncells))?,
-            ));
-        }
+        let lab = side_arrays(&ctx, &p.cell_data, p.ncells)?;
         if let Some(prev) = labelled
             && prev != lab.is_some()
         {
@@ -566,11 +527,8 @@ pub fn parse_surface(data: &[u8], file: &str) -> Result<SurfaceRead> {
                 }
                 None => [1, 0],
             };
-            if c.len() > 3 {
-                split += 1;
-            }
-            for k in 1..c.len() - 1 {
-                triangles.push([c[0], c[k], c[k + 1]]);
+            for t in crate::common::fan(&c, &mut split) {
+                triangles.push(t);
                 sides.push(side);
             }
         }

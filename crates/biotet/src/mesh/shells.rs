@@ -224,8 +224,9 @@ fn alone(points: &[[f64; 3]], tris: &[[u32; 3]]) -> SurfaceMesh {
     SurfaceMesh::closed(pts, tris, 1)
 }
 
-/// Whether some edge has only one triangle.
-fn has_open_edge(tris: &[[u32; 3]]) -> bool {
+/// Whether some edge has only one triangle (open) and whether some has more than two
+/// (non-manifold).
+fn edge_uses(tris: &[[u32; 3]]) -> (bool, bool) {
     let mut count: FxHashMap<(u32, u32), u32> = Default::default();
     for t in tris {
         for k in 0..3 {
@@ -233,23 +234,10 @@ fn has_open_edge(tris: &[[u32; 3]]) -> bool {
             *count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
         }
     }
-    count.values().any(|&c| c == 1)
-}
-
-/// Whether some edge has more than two triangles.
-fn is_non_manifold(tris: &[[u32; 3]]) -> bool {
-    let mut count: FxHashMap<(u32, u32), u32> = Default::default();
-    for t in tris {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            let c = count.entry((a.min(b), a.max(b))).or_insert(0);
-            *c += 1;
-            if *c > 2 {
-                return true;
-            }
-        }
-    }
-    false
+    (
+        count.values().any(|&c| c == 1),
+        count.values().any(|&c| c > 2),
+    )
 }
 
 /// Label a (possibly non-manifold) surface from the cells its triangles bound: every bounded
@@ -401,10 +389,11 @@ pub fn assemble(parts: Vec<Part>) -> Result<(SurfaceMesh, Vec<Shell>), AssembleE
     // (shells that touch, each with its own copies of the shared points, stay apart and share
     // an interface); the welded indices when some edge is open in its own (a triangle soup, as
     // a PLY or OBJ written without merging points, where each triangle would be a shell).
-    let joined: Vec<bool> = parts
+    let own: Vec<(bool, bool)> = parts
         .iter()
-        .map(|p| has_open_edge(&p.surface.triangles))
+        .map(|p| edge_uses(&p.surface.triangles))
         .collect();
+    let joined: Vec<bool> = own.iter().map(|u| u.0).collect();
     let topo = |k: usize| -> &[[u32; 3]] {
         if joined[k] {
             &welded[k]
@@ -418,7 +407,15 @@ pub fn assemble(parts: Vec<Part>) -> Result<(SurfaceMesh, Vec<Shell>), AssembleE
         tris.iter()
             .any(|t| t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
     };
-    if let Some(k) = (0..parts.len()).find(|&k| is_non_manifold(topo(k)) && !collapsed(topo(k))) {
+    let non_manifold = |k: usize| {
+        let over = if joined[k] {
+            edge_uses(&welded[k]).1
+        } else {
+            own[k].1
+        };
+        over && !collapsed(topo(k))
+    };
+    if let Some(k) = (0..parts.len()).find(|&k| non_manifold(k)) {
         if parts.len() > 1 {
             return Err(AssembleError::NonManifoldWithOthers);
         }
