@@ -1570,7 +1570,90 @@ fn shells_touching_along_an_edge_or_at_a_vertex_are_two_regions() {
             );
         }
         assert_eq!(c["surface"]["interfaces"].as_array().unwrap().len(), 2);
+        // Converted without `--regions`, the surface carries no labels to the formats that
+        // hold them (they used to declare both shells region 1, and the mesh was refused): the
+        // same mesh, byte for byte.
+        let want = std::fs::read(&vtu).unwrap();
+        for ext in ["vtu", "vtp", "vtk", "ply", "mesh"] {
+            let conv = dir.path().join(format!("conv.{ext}"));
+            let c = biotet(&["convert", s(&off), "-o", s(&conv)]);
+            assert!(c.status.success(), "{name} {ext}: {}", stderr(&c));
+            let again = dir.path().join("again.vtu");
+            let m = biotet(&["mesh", s(&conv), "-o", s(&again)]);
+            assert!(m.status.success(), "{name} {ext}: {}", stderr(&m));
+            assert!(
+                std::fs::read(&again).unwrap() == want,
+                "{name} {ext}: another mesh"
+            );
+        }
     }
+}
+
+#[test]
+fn solids_sharing_a_face_in_one_stl_are_two_regions() {
+    // An assembly saved as one STL: [0,1]^3 and its mirror image [-1,0]x[0,1]^2, each with its
+    // whole boundary, so the face x = 0 comes twice (opposite orientations, the same diagonal).
+    // It was refused as overlapping triangles; it is two regions and one interface.
+    let quads = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    let corner = |i: usize, sx: f64| [sx * (i & 1) as f64, ((i >> 1) & 1) as f64, (i >> 2) as f64];
+    let mut stl = String::from("solid assembly\n");
+    for sx in [1.0, -1.0] {
+        for q in quads {
+            for tri in [[q[0], q[1], q[2]], [q[0], q[2], q[3]]] {
+                // The mirror image turns orientation: its triangles are given reversed.
+                let tri = if sx < 0.0 {
+                    [tri[0], tri[2], tri[1]]
+                } else {
+                    tri
+                };
+                stl += "facet normal 0 0 0\nouter loop\n";
+                for v in tri {
+                    let p = corner(v, sx);
+                    stl += &format!("vertex {} {} {}\n", p[0], p[1], p[2]);
+                }
+                stl += "endloop\nendfacet\n";
+            }
+        }
+    }
+    stl += "endsolid assembly\n";
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("assembly.stl");
+    std::fs::write(&input, stl).unwrap();
+    let v = biotet(&["validate", s(&input)]);
+    assert!(v.status.success(), "{}", stderr(&v));
+    let out = dir.path().join("assembly.vtu");
+    let j = json_of(&biotet(&["mesh", s(&input), "-o", s(&out), "--json"]));
+    assert_eq!(j["quality"]["n_regions"], 2, "{j}");
+    assert_eq!(j["pipeline"]["missing_triangles"], 0, "{j}");
+    let c = json_of(&biotet(&[
+        "check",
+        s(&out),
+        "--surface",
+        s(&input),
+        "--json",
+    ]));
+    assert_eq!(c["valid"], true, "{c}");
+    let inter: Vec<&Value> = c["surface"]["interfaces"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|i| {
+            i["labels"]
+                .as_array()
+                .is_some_and(|l| !l.contains(&0.into()))
+        })
+        .collect();
+    assert!(
+        inter.iter().any(|i| i["expected"] == 2 && i["found"] == 2),
+        "{c}"
+    );
 }
 
 #[test]
@@ -1851,6 +1934,30 @@ fn remesh_insert_embeds_a_surface_and_refuses_one_crossing_the_boundary() {
         &format!("{lesion_name}=5"),
     ]);
     assert!(check.status.success(), "{}", stderr(&check));
+    // The lesion as a triangle soup: welded (and said), the same mesh.
+    let soup = dir.path().join("lesion_soup.ply");
+    let read = biotet_io::read_surface(&lesion).unwrap().mesh;
+    biotet_io::write_surface(&soup, &support::soup(&read)).unwrap();
+    let again = dir.path().join("again.vtu");
+    let out = biotet(&[
+        "remesh",
+        s(&base),
+        "--insert",
+        s(&soup),
+        "--label",
+        "5",
+        "--size",
+        "0.08",
+        "-o",
+        s(&again),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("duplicate vertices"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(std::fs::read(&again).unwrap() == std::fs::read(&new).unwrap());
 
     // Across the outer boundary: refused on one line naming the triangle, the boundary and a
     // point; nothing written.

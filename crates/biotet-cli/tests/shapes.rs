@@ -4,6 +4,7 @@
 //! keep every input triangle and pass `biotet check --surface`; the files named `invalid_*` are
 //! refused by `validate` and `mesh`, which then writes nothing.
 
+mod support;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -460,18 +461,7 @@ fn a_triangle_soup_meshes_as_its_welded_surface() {
     // (trimesh's export of an STL it did not process): one shell, not one per triangle.
     let dir = tempfile::tempdir().unwrap();
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/shapes/tm_capsule.off");
-    let s = biotet_io::read_surface(&src).unwrap().mesh;
-    let mut soup = biotet::SurfaceMesh {
-        points: Vec::new(),
-        triangles: Vec::new(),
-        sides: Vec::new(),
-    };
-    for (t, side) in s.triangles.iter().zip(&s.sides) {
-        let base = soup.points.len() as u32;
-        soup.points.extend(t.map(|v| s.points[v as usize]));
-        soup.triangles.push([base, base + 1, base + 2]);
-        soup.sides.push(*side);
-    }
+    let soup = support::soup(&biotet_io::read_surface(&src).unwrap().mesh);
     for ext in ["ply", "obj"] {
         let path = dir.path().join(format!("soup.{ext}"));
         biotet_io::write_surface(&path, &soup).unwrap();

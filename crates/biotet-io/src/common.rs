@@ -136,12 +136,12 @@ pub(crate) fn check_surface(m: &SurfaceMesh, file: &str) -> Result<()> {
     check_cells(&m.triangles, m.points.len(), "triangle", file)
 }
 
-/// Validate a surface with its side labels before writing them: one pair a triangle, each label
-/// fitting a signed 32-bit integer (VTK's `Int32`).
+/// Validate a surface with its side labels before writing them: one pair a triangle (or none: a
+/// surface without labels), each label fitting a signed 32-bit integer (VTK's `Int32`).
 pub(crate) fn check_sided_surface(m: &SurfaceMesh, file: &str) -> Result<()> {
     check_surface(m, file)?;
     let nt = m.triangles.len();
-    if m.sides.len() != nt {
+    if m.sides.len() != nt && !m.sides.is_empty() {
         return Err(Error::invalid(
             file,
             format!("{} side-label pairs for {nt} triangles", m.sides.len()),

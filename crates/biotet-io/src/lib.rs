@@ -334,7 +334,9 @@ pub fn read_surface_as(path: &Path, format: SurfaceFormat) -> Result<SurfaceRead
     }
 }
 
-/// Write a surface, choosing the format by extension (`.stl` binary, `.ply` binary).
+/// Write a surface, choosing the format by extension (`.stl` binary, `.ply` binary). Side labels
+/// go where the format holds them (`.vtu`, `.vtp`, `.vtk` `sides`; `.ply` when some side is not
+/// `[1, 0]`; `.mesh` refs); a surface whose `sides` is empty is written without them.
 pub fn write_surface(path: &Path, mesh: &SurfaceMesh) -> Result<()> {
     write_surface_as(path, mesh, SurfaceFormat::from_path(path)?)
 }

@@ -16,7 +16,8 @@
 //! below writes. A triangle between two regions is given either once (its front region is then
 //! taken from the geometry: the region that the other triangles of that cell name) or twice with
 //! opposite orientations, once in the closed boundary of each region, as a file concatenating
-//! every region's outward surface has it; the second copy is merged into the first. A negative
+//! every region's outward surface has it; the second copy is merged into the first (copies are
+//! matched by their corners' coordinates, so each region may come on its own points). A negative
 //! ref, a copy with the same orientation or the same ref, or a third copy is an error naming
 //! the line and the triangle. Refs that are all equal (say all 0 or all 1), or that include a
 //! negative one, carry no regions: the surface is read as closed shells, as from any other
@@ -39,6 +40,7 @@
 
 use std::io::{BufRead, Write};
 
+use biotet::mesh::coord_key;
 use biotet::mesh::side_labels::FROM_GEOMETRY;
 use biotet::{SurfaceMesh, TetMesh, TriMesh};
 
@@ -236,7 +238,7 @@ pub fn parse_surface(data: &[u8], file: &str) -> Result<SurfaceRead> {
         && m.tri_refs.windows(2).any(|w| w[0] != w[1])
         && m.tri_refs.iter().all(|&r| side_label_of(r).is_ok());
     let (tris, tri_refs, side_labels) = if labelled {
-        let (t, r, sides) = sides_from_refs(&m.tris, &m.tri_refs, &m.tri_lines, file)?;
+        let (t, r, sides) = sides_from_refs(&m.verts, &m.tris, &m.tri_refs, &m.tri_lines, file)?;
         (t, r, Some(sides))
     } else {
         (m.tris, m.tri_refs, None)
@@ -257,14 +259,23 @@ pub fn parse_surface(data: &[u8], file: &str) -> Result<SurfaceRead> {
 /// Triangle refs as region labels (see the module documentation): each ref names the region
 /// behind its triangle; a triangle given twice, with opposite orientations, names both sides and
 /// is kept once (the first copy); a triangle given once leaves its front to the geometry
-/// ([`FROM_GEOMETRY`]). Returns the kept triangles, their refs and their side labels.
+/// ([`FROM_GEOMETRY`]). Copies are matched by their corners' coordinates, so a file that gives
+/// each region's boundary on its own copies of the points pairs its interfaces too. Returns the
+/// kept triangles, their refs and their side labels.
 #[allow(clippy::type_complexity)]
 fn sides_from_refs(
+    verts: &[[f64; 3]],
     tris: &[[u32; 3]],
     refs: &[i64],
     lines: &[usize],
     file: &str,
 ) -> Result<(Vec<[u32; 3]>, Vec<i64>, Vec<[u32; 2]>)> {
+    // Each point as the first point of its coordinates (corners are in range: `parse` checks).
+    let mut at: std::collections::HashMap<[u64; 3], u32> = Default::default();
+    let canon: Vec<u32> = (0..verts.len() as u32)
+        .map(|i| *at.entry(coord_key(&verts[i as usize])).or_insert(i))
+        .collect();
+    let canon = |t: &[u32; 3]| t.map(|v| canon[v as usize]);
     let mut first: std::collections::HashMap<[u32; 3], usize> = Default::default();
     let mut kept = Vec::with_capacity(tris.len());
     let mut kept_refs = Vec::with_capacity(tris.len());
@@ -274,7 +285,8 @@ fn sides_from_refs(
     for (j, (t, &r)) in tris.iter().zip(refs).enumerate() {
         let err = |msg: String| Error::line(file, lines[j], format!("triangle {j}: {msg}"));
         let label = side_label_of(r).map_err(&err)?;
-        let mut key = *t;
+        let c = canon(t);
+        let mut key = c;
         key.sort_unstable();
         match first.get(&key) {
             None => {
@@ -286,8 +298,8 @@ fn sides_from_refs(
             }
             Some(&k) => {
                 let i = origin[k];
-                let a = kept[k];
-                let same = (0..3).any(|s| [a[s], a[(s + 1) % 3], a[(s + 2) % 3]] == *t);
+                let a = canon(&kept[k]);
+                let same = (0..3).any(|s| [a[s], a[(s + 1) % 3], a[(s + 2) % 3]] == c);
                 if same {
                     return Err(err(format!(
                         "repeats triangle {i} with the same orientation; a triangle between two \

@@ -104,7 +104,8 @@ pub fn write_tet<W: Write>(w: W, mesh: &TetMesh, file: &str) -> Result<()> {
     Ok(())
 }
 
-/// Write a surface as binary legacy VTK (see the module docs).
+/// Write a surface as binary legacy VTK (see the module docs); `sides` left out when
+/// `mesh.sides` is empty (a surface without labels).
 pub fn write_surface<W: Write>(w: W, mesh: &SurfaceMesh, file: &str) -> Result<()> {
     check_sided_surface(mesh, file)?;
     let nt = mesh.triangles.len();
@@ -113,17 +114,19 @@ pub fn write_surface<W: Write>(w: W, mesh: &SurfaceMesh, file: &str) -> Result<(
     let mut out = Out::new(w);
     head(&mut out, "biotet surface", "POLYDATA", &mesh.points);
     cells(&mut out, "POLYGONS", &mesh.triangles);
-    out.s("CELL_DATA ");
-    out.int(nt);
-    out.s("\nFIELD FieldData 1\nsides 2 ");
-    out.int(nt);
-    out.s(" int\n");
-    for s in &mesh.sides {
-        for &l in s {
-            out.bytes(&(l as i32).to_be_bytes());
+    if !mesh.sides.is_empty() {
+        out.s("CELL_DATA ");
+        out.int(nt);
+        out.s("\nFIELD FieldData 1\nsides 2 ");
+        out.int(nt);
+        out.s(" int\n");
+        for s in &mesh.sides {
+            for &l in s {
+                out.bytes(&(l as i32).to_be_bytes());
+            }
         }
+        out.c(b'\n');
     }
-    out.c(b'\n');
     out.finish().map_err(|e| Error::io(file, e))?;
     Ok(())
 }

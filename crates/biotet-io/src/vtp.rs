@@ -222,19 +222,22 @@ pub fn parse_surface(data: &[u8], file: &str) -> Result<SurfaceRead> {
 }
 
 /// Write a surface as VTP (appended raw binary): the triangles as polygons and the cell-data
-/// array `sides` (`Int32`, two components: the regions behind and in front of each triangle).
+/// array `sides` (`Int32`, two components: the regions behind and in front of each triangle; left out
+/// when `mesh.sides` is empty, a surface without labels).
 pub fn write_surface<W: Write>(w: W, mesh: &SurfaceMesh, file: &str) -> Result<()> {
     check_sided_surface(mesh, file)?;
     let nt = mesh.triangles.len();
     let np = mesh.points.len();
     let wide = np > i32::MAX as usize || 3 * nt > i32::MAX as usize;
-    let arrays = [
+    let mut arrays = vec![
         Array::new("Points", 3, Ty::F64, np, |r| {
             Data::F64(mesh.points[r].as_flattened().to_vec())
         }),
         cells_connectivity(&mesh.triangles, wide),
         cells_offsets::<3>(nt, wide),
-        Array::new("sides", 2, Ty::I32, nt, |r| {
+    ];
+    if !mesh.sides.is_empty() {
+        arrays.push(Array::new("sides", 2, Ty::I32, nt, |r| {
             Data::I32(
                 mesh.sides[r]
                     .as_flattened()
@@ -242,8 +245,8 @@ pub fn write_surface<W: Write>(w: W, mesh: &SurfaceMesh, file: &str) -> Result<(
                     .map(|&l| l as i32)
                     .collect(),
             )
-        }),
-    ];
+        }));
+    }
     vtu_out::write_grid(
         w,
         Grid::Poly,

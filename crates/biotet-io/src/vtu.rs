@@ -544,20 +544,23 @@ pub fn parse_surface(data: &[u8], file: &str) -> Result<SurfaceRead> {
 }
 
 /// Write a surface as VTU (appended raw binary): triangles (VTK type 5) and the cell-data array
-/// `sides` (`Int32`, two components: the regions behind and in front of each triangle).
+/// `sides` (`Int32`, two components: the regions behind and in front of each triangle; left out
+/// when `mesh.sides` is empty, a surface without labels).
 pub fn write_surface<W: Write>(w: W, mesh: &SurfaceMesh, file: &str) -> Result<()> {
     check_sided_surface(mesh, file)?;
     let nt = mesh.triangles.len();
     let np = mesh.points.len();
     let wide = np > i32::MAX as usize || 3 * nt > i32::MAX as usize;
-    let arrays = [
+    let mut arrays = vec![
         Array::new("Points", 3, Ty::F64, np, |r| {
             Data::F64(mesh.points[r].as_flattened().to_vec())
         }),
         cells_connectivity(&mesh.triangles, wide),
         cells_offsets::<3>(nt, wide),
         Array::new("types", 1, Ty::U8, nt, |r| Data::U8(vec![5; r.len()])),
-        Array::new("sides", 2, Ty::I32, nt, |r| {
+    ];
+    if !mesh.sides.is_empty() {
+        arrays.push(Array::new("sides", 2, Ty::I32, nt, |r| {
             Data::I32(
                 mesh.sides[r]
                     .as_flattened()
@@ -565,8 +568,8 @@ pub fn write_surface<W: Write>(w: W, mesh: &SurfaceMesh, file: &str) -> Result<(
                     .map(|&l| l as i32)
                     .collect(),
             )
-        }),
-    ];
+        }));
+    }
     vtu_out::write_grid(
         w,
         vtu_out::Grid::Unstructured,

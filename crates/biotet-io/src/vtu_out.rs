@@ -372,7 +372,10 @@ pub(crate) fn write_grid<W: Write>(
             out.s(">\n");
         }
     }
-    out.s("      </CellData>\n    </Piece>\n  </");
+    if arrays.len() > first_cell_array {
+        out.s("      </CellData>\n");
+    }
+    out.s("    </Piece>\n  </");
     out.s(kind);
     out.s(">\n");
     if matches!(enc, VtuEncoding::Raw | VtuEncoding::RawZlib) {

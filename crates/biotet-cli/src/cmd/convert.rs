@@ -77,7 +77,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
         }
         MeshKind::Surface => {
             // Conversion keeps the surface as it is (no validation), welded like any read;
-            // side labels travel with it.
+            // side labels travel with it, and a surface without them is written without.
             let read = biotet_io::read_surface(&a.input)?;
             let partial = read.side_labels.as_ref().is_some_and(|s| {
                 s.iter()
@@ -102,7 +102,12 @@ pub fn run(a: Args) -> Result<ExitCode> {
                 )?
                 .0
             } else {
-                read.mesh
+                // No labels read or derived: none written (VTK's `sides` would declare every
+                // shell region 1).
+                SurfaceMesh {
+                    sides: Vec::new(),
+                    ..read.mesh
+                }
             };
             stage.set(format!("writing {}", a.output.display()));
             biotet_io::write_surface(&a.output, &m)?;

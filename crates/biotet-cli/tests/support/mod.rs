@@ -37,3 +37,16 @@ pub fn json_of(out: &Output) -> Value {
 pub fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
 }
+
+/// `s` as a triangle soup: each triangle on three points of its own (as a PLY or OBJ exporter
+/// that does not merge points writes it).
+pub fn soup(s: &biotet::SurfaceMesh) -> biotet::SurfaceMesh {
+    let mut soup = biotet::SurfaceMesh::default();
+    for (t, side) in s.triangles.iter().zip(&s.sides) {
+        let base = soup.points.len() as u32;
+        soup.points.extend(t.map(|v| s.points[v as usize]));
+        soup.triangles.push([base, base + 1, base + 2]);
+        soup.sides.push(*side);
+    }
+    soup
+}

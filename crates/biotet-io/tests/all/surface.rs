@@ -358,3 +358,52 @@ fn vtu_side_labels_from_surface_nets_names_and_errors() {
         biotet_io::MeshKind::Tetrahedra
     );
 }
+
+#[test]
+fn a_surface_without_labels_is_written_without_them() {
+    // `sides` empty: the VTK formats write no `sides` array (read back: no side labels, every
+    // triangle [1, 0]), PLY no label properties; with labels, they travel.
+    let mut m = box_surface(2, 1.0);
+    let labelled = m.clone();
+    m.sides.clear();
+    let dir = tempfile::tempdir().unwrap();
+    for ext in ["vtu", "vtp", "vtk", "ply", "mesh", "off"] {
+        let p = dir.path().join(format!("s.{ext}"));
+        biotet_io::write_surface(&p, &m).unwrap();
+        let r = biotet_io::read_surface(&p).unwrap();
+        assert_eq!(r.side_labels, None, "{ext}");
+        assert_same_surface(&r.mesh, &labelled, ext);
+        if ext != "off" {
+            let mut two = labelled.clone();
+            two.sides[0] = [2, 1];
+            biotet_io::write_surface(&p, &two).unwrap();
+            let r = biotet_io::read_surface(&p).unwrap();
+            let got = r.side_labels.expect(ext);
+            assert_eq!(got[0][0], 2, "{ext}");
+        }
+    }
+}
+
+#[test]
+fn medit_regions_on_their_own_copies_of_the_points_pair_their_interface() {
+    // Two tets sharing the face (0,0,0) (1,0,0) (0,1,0): region 1 above it, region 2 below,
+    // each written as its own outward boundary on its own four points (as a file concatenating
+    // per-region exports has it). The shared face is one triangle with sides [1, 2] (or [2, 1]).
+    let text = "MeshVersionFormatted 2\nDimension 3\nVertices\n8\n\
+        0 0 0 0\n1 0 0 0\n0 1 0 0\n0 0 1 0\n\
+        0 0 0 0\n1 0 0 0\n0 1 0 0\n0 0 -1 0\n\
+        Triangles\n8\n\
+        1 3 2 1\n1 2 4 1\n1 4 3 1\n2 3 4 1\n\
+        5 6 7 2\n5 8 6 2\n5 7 8 2\n6 8 7 2\nEnd\n";
+    let r = medit::parse_surface(text.as_bytes(), "two.mesh").unwrap();
+    assert_eq!(r.mesh.triangles.len(), 7);
+    let sides = r.side_labels.unwrap();
+    let shared: Vec<&[u32; 2]> = sides
+        .iter()
+        .filter(|s| !s.contains(&biotet::mesh::side_labels::FROM_GEOMETRY))
+        .collect();
+    assert_eq!(shared.len(), 1, "{sides:?}");
+    let mut pair = *shared[0];
+    pair.sort_unstable();
+    assert_eq!(pair, [1, 2]);
+}

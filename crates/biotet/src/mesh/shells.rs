@@ -15,7 +15,9 @@
 //! multi-material marching cubes writes: three regions along an edge) is labelled from its
 //! arrangement instead ([`label_arrangement`]): the triangles, taken on both sides, split space
 //! into cells by their exact angular order around every edge; nested cells are resolved by exact
-//! point location; each bounded region gets a label.
+//! point location; each bounded region gets a label. Solids that share a face, each given with
+//! its whole boundary in one welded file (an assembly saved as one STL), have that face twice
+//! with opposite orientations: one copy is kept, and the arrangement labels its two sides.
 //!
 //! Shells touching only along an edge (no shared triangle) make their part non-manifold: it is
 //! labelled from its arrangement, each shell its own region, the edge shared by them; shells
@@ -76,12 +78,22 @@ pub enum AssembleError {
     /// A non-manifold part given with other parts.
     #[error("a non-manifold surface (more than two triangles at an edge) must be given alone")]
     NonManifoldWithOthers,
-    /// The triangles do not split space into consistent cells.
+    /// The triangles do not split space into consistent cells: the edge where they do not,
+    /// by its points' indices (in the welded numbering) and coordinates.
     #[error(
-        "the triangles around edge ({0}, {1}) do not bound consistent regions (crossing or \
-         overlapping triangles)"
+        "the triangles around edge ({a}, {b}) {}–{} do not bound consistent regions (crossing \
+         or overlapping triangles)",
+        crate::text::point(&at[0]),
+        crate::text::point(&at[1])
     )]
-    Arrangement(u32, u32),
+    Arrangement {
+        /// One end's point index.
+        a: u32,
+        /// The other end's.
+        b: u32,
+        /// Their coordinates.
+        at: [[f64; 3]; 2],
+    },
     /// A shell shares triangles with the shell around it.
     #[error(
         "shell {inner} shares triangles with shell {outer} around it (a region touching the \
@@ -240,6 +252,37 @@ fn edge_uses(tris: &[[u32; 3]]) -> (bool, bool) {
     )
 }
 
+/// One copy of each triangle given twice with opposite orientations on the same corners: solids
+/// that share a face, each given with its whole boundary in one welded file (an assembly saved
+/// as one STL), have that face once in each; the arrangement needs it once, and labels its two
+/// sides. The first copy is kept; other repeats are left for the arrangement to refuse.
+fn merge_opposite_copies(mut s: SurfaceMesh) -> SurfaceMesh {
+    // Corners sorted -> the first copy, while it is unpaired.
+    let mut open: FxHashMap<[u32; 3], usize> = Default::default();
+    let mut drop = vec![false; s.triangles.len()];
+    for (t, tri) in s.triangles.iter().enumerate() {
+        let mut key = *tri;
+        key.sort_unstable();
+        if let Some(&f) = open.get(&key) {
+            let a = s.triangles[f];
+            let same = (0..3).any(|r| [a[r], a[(r + 1) % 3], a[(r + 2) % 3]] == *tri);
+            if !same {
+                drop[t] = true;
+                open.remove(&key);
+            }
+        } else {
+            open.insert(key, t);
+        }
+    }
+    if drop.contains(&true) {
+        let mut keep = drop.iter().map(|&d| !d);
+        s.triangles.retain(|_| keep.next().unwrap_or(true));
+        let mut keep = drop.iter().map(|&d| !d);
+        s.sides.retain(|_| keep.next().unwrap_or(true));
+    }
+    s
+}
+
 /// Label a (possibly non-manifold) surface from the cells its triangles bound: every bounded
 /// region gets a label, 1, 2, … in order of its first triangle, or `labels[k]` for the k-th.
 /// Triangle orientations are kept; `sides` are set.
@@ -257,7 +300,11 @@ pub fn label_arrangement(
     let mut cell = Vec::new();
     let n = crate::lastresort::cells::Cells::default()
         .split(&s.points, &half, &mut cell)
-        .map_err(|(a, b)| AssembleError::Arrangement(a, b))?;
+        .map_err(|(a, b)| AssembleError::Arrangement {
+            a,
+            b,
+            at: [a, b].map(|v| s.points[v as usize]),
+        })?;
     // Each cell is a closed surface with normals into it: negative outward volume means it
     // bounds a finite region from outside; positive, that it is the outer side of a solid (a
     // hole in the region around it, or the boundary of the unbounded region).
@@ -419,15 +466,16 @@ pub fn assemble(parts: Vec<Part>) -> Result<(SurfaceMesh, Vec<Shell>), AssembleE
         if parts.len() > 1 {
             return Err(AssembleError::NonManifoldWithOthers);
         }
-        if !joined[k] {
-            return label_arrangement(&parts[k].surface, parts[k].labels.as_deref());
-        }
-        let s = SurfaceMesh {
-            points,
-            triangles: welded[k].clone(),
-            sides: parts[k].surface.sides.clone(),
+        let s = if joined[k] {
+            SurfaceMesh {
+                points,
+                triangles: welded[k].clone(),
+                sides: parts[k].surface.sides.clone(),
+            }
+        } else {
+            parts[k].surface.clone()
         };
-        return label_arrangement(&s, parts[k].labels.as_deref());
+        return label_arrangement(&merge_opposite_copies(s), parts[k].labels.as_deref());
     }
     // Shell triangles, per shell, mapped to the welded points.
     let mut shell_tris: Vec<Vec<[u32; 3]>> = Vec::new();

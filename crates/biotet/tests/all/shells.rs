@@ -354,10 +354,30 @@ fn a_triangle_soup_assembles_as_its_welded_surface() {
     // closed in the file's numbering): two shells and one interface, as before any welding.
     let mut pair = cube_surface([0.0; 3], 1.0);
     pair.append(&cube_surface([1.0, 0.0, 0.0], 1.0));
-    let (mut s, shells) = assemble(vec![part(pair, None)]).unwrap();
+    let (mut s, shells) = assemble(vec![part(pair.clone(), None)]).unwrap();
     assert_eq!(shells.len(), 2);
     assert_eq!(s.sides.iter().filter(|x| x[0] != 0 && x[1] != 0).count(), 2);
     validate_surface(&mut s, &ValidateOptions::default()).unwrap();
+    // The same two cubes as a soup, and welded (as an STL of the assembly is read): the shared
+    // face comes twice, once in each cube's boundary with opposite orientations; it is one
+    // interface between two regions (this was refused as overlapping triangles).
+    let mut welded = pair.clone();
+    welded.weld_exact();
+    for given in [soup(&pair), welded] {
+        let (mut s, shells) = assemble(vec![part(given, None)]).unwrap();
+        assert_eq!(shells.len(), 2);
+        assert_eq!(s.triangles.len(), 22);
+        let mut inter: Vec<[u32; 2]> = s
+            .sides
+            .iter()
+            .filter(|x| x[0] != 0 && x[1] != 0)
+            .copied()
+            .collect();
+        inter.dedup();
+        assert_eq!(inter.len(), 1, "{:?}", s.sides);
+        assert_eq!(s.sides.iter().filter(|x| x[0] != 0 && x[1] != 0).count(), 2);
+        validate_surface(&mut s, &ValidateOptions::default()).unwrap();
+    }
     // A soup whose points collapse (two corners of a triangle at one position) is left to the
     // validation, which names the triangle.
     let mut flat = soup(&outer);
