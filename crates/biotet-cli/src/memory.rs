@@ -194,6 +194,9 @@ fn extent(
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     // The inside volume: triangles with the outside on one side only (interfaces add nothing).
+    // Cones from a point of the surface, not the origin: far from it (coordinates of 1e9) the
+    // terms would cancel to noise larger than the volume.
+    let o = surface.points.first().copied().unwrap_or([0.0; 3]);
     let mut volume = 0.0;
     for (t, s) in surface.triangles.iter().zip(&surface.sides) {
         let [a, b, c] = t.map(|v| surface.points[v as usize]);
@@ -203,8 +206,7 @@ fn extent(
                 hi[i] = hi[i].max(p[i]);
             }
         }
-        let det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
-            + a[2] * (b[0] * c[1] - b[1] * c[0]);
+        let det = biotet::geom::vec3::volume6(o, a, b, c);
         let sign = match (s[0] != 0, s[1] != 0) {
             (true, false) => 1.0,
             (false, true) => -1.0,

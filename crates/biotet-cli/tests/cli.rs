@@ -1590,6 +1590,31 @@ fn shells_touching_along_an_edge_or_at_a_vertex_are_two_regions() {
 }
 
 #[test]
+fn a_surface_far_from_the_origin_meshes() {
+    // An ellipsoid at (1e9, -2e9, 3e9) (survey or micrometre coordinates): the memory estimate
+    // summed cones from the origin, whose terms cancelled to noise a million times the volume,
+    // and refused it as needing petabytes. Meshed like the same ellipsoid at the origin.
+    let dir = tempfile::tempdir().unwrap();
+    let mut tets = Vec::new();
+    for c in [[0.0; 3], [1e9, -2e9, 3e9]] {
+        let input = dir.path().join("far.off");
+        std::fs::write(&input, ellipsoid_off(c, [1.0, 0.8, 0.6])).unwrap();
+        let out = dir.path().join("far.vtu");
+        let j = json_of(&biotet(&["mesh", s(&input), "-o", s(&out), "--json"]));
+        let c = biotet(&["check", s(&out), "--surface", s(&input), "-q"]);
+        assert!(c.status.success(), "{}", stderr(&c));
+        let v = j["quality"]["volume"].as_f64().unwrap();
+        assert!(
+            (v - 4.0 / 3.0 * std::f64::consts::PI * 0.48).abs() < 0.1,
+            "{j}"
+        );
+        tets.push(j["pipeline"]["n_tets"].as_u64().unwrap());
+    }
+    // Rounding differs far away, so the meshes may too, but not by much.
+    assert!(tets[1].abs_diff(tets[0]) * 5 < tets[0], "{tets:?}");
+}
+
+#[test]
 fn solids_sharing_a_face_in_one_stl_are_two_regions() {
     // An assembly saved as one STL: [0,1]^3 and its mirror image [-1,0]x[0,1]^2, each with its
     // whole boundary, so the face x = 0 comes twice (opposite orientations, the same diagonal).
