@@ -25,7 +25,9 @@ use biotet::image::surface::{ImageSummary, ImageSurfaceError, labelled_surface};
 use biotet::lastresort::{ImproveOptions, Metric, RecoverOptions, improve, recover};
 use biotet::mesh::shells::{Part, assemble};
 use biotet::mesh::side_labels;
-use biotet::mesh::validate::{ValidateOptions, validate_surface};
+use biotet::mesh::validate::{
+    SurfaceError, ValidateOptions, check_self_intersections, validate_surface,
+};
 use biotet::pipeline::{PipelineOptions, mesh_surface};
 use biotet::quality::{QualityReport, forced};
 use biotet::sizing::{SizeSpec, Sizing, SizingOptions};
@@ -157,9 +159,13 @@ struct Prepared {
 }
 
 /// Validate a labelled surface as `biotet mesh` does: shells assembled and labelled innermost
-/// first, or the file's own side labels resolved against the geometry.
-fn prepare(surface: Surface) -> Result<(SurfaceMesh, serde_json::Value), Failure> {
-    let opts = ValidateOptions::default();
+/// first, or the file's own side labels resolved against the geometry. With `crossings`
+/// (the surface stage follows, which untangles them), crossing triangles are let through.
+fn prepare(surface: Surface, crossings: bool) -> Result<(SurfaceMesh, serde_json::Value), Failure> {
+    let opts = ValidateOptions {
+        self_intersections: !crossings,
+        ..ValidateOptions::default()
+    };
     match surface {
         Surface::Parts(parts, name) => {
             let (mut s, shells) = assemble(parts).map_err(|e| {
@@ -168,7 +174,7 @@ fn prepare(surface: Surface) -> Result<(SurfaceMesh, serde_json::Value), Failure
                     format!("{name}: cannot assemble the surfaces: {e}"),
                 )
             })?;
-            validate_surface(&mut s, &opts).map_err(|e| Failure::invalid(&name, &e))?;
+            validate_surface(&mut s, &opts).map_err(|e| refusal(&s, &name, e, crossings))?;
             Ok((s, serde_json::to_value(shells).unwrap_or_default()))
         }
         Surface::Sided(mut s, name) => {
@@ -180,7 +186,7 @@ fn prepare(surface: Surface) -> Result<(SurfaceMesh, serde_json::Value), Failure
                 .flatten()
                 .any(|&l| l == side_labels::FROM_GEOMETRY);
             if !partial {
-                validate_surface(&mut s, &opts).map_err(|e| Failure::invalid(&name, &e))?;
+                validate_surface(&mut s, &opts).map_err(|e| refusal(&s, &name, e, crossings))?;
             }
             let resolved = side_labels::resolve(&s).map_err(|e| {
                 Failure::new(
@@ -189,9 +195,21 @@ fn prepare(surface: Surface) -> Result<(SurfaceMesh, serde_json::Value), Failure
                 )
             })?;
             let mut s = resolved.surface;
-            validate_surface(&mut s, &opts).map_err(|e| Failure::invalid(&name, &e))?;
+            validate_surface(&mut s, &opts).map_err(|e| refusal(&s, &name, e, crossings))?;
             Ok((s, serde_json::to_value(resolved.shells).unwrap_or_default()))
         }
+    }
+}
+
+/// A validation error as the CLI says it: where crossing triangles were let through and the
+/// validation failed all the same, the crossings named as the cause, without the way out (the
+/// stage was asked for); else as it is, a crossing's with the way out.
+fn refusal(s: &SurfaceMesh, name: &str, e: SurfaceError, crossings: bool) -> Failure {
+    if crossings {
+        let first = check_self_intersections(s, ValidateOptions::default().max_examples);
+        Failure::refused(name, &first.err().unwrap_or(e), false)
+    } else {
+        Failure::invalid(name, &e)
     }
 }
 
@@ -399,10 +417,11 @@ fn mesh_with(
     Ok((mesh, report))
 }
 
-/// The validated surface of `prepare` as the pipeline's input.
-fn prepared(surface: Surface) -> Result<Prepared, Failure> {
+/// The validated surface of `prepare` as the pipeline's input (crossing triangles let through
+/// when `o` asks for the surface stage, which untangles them).
+fn prepared(surface: Surface, o: &MeshOptions) -> Result<Prepared, Failure> {
     let name = surface.name().to_string();
-    let (surface, shells) = prepare(surface)?;
+    let (surface, shells) = prepare(surface, o.surface_tolerance.is_some())?;
     Ok(Prepared {
         surface,
         shells,
@@ -454,7 +473,7 @@ fn mesh_arrays<'py>(
     )?;
     let (mesh, report) = guarded(py, threads, move || {
         let progress = |s: &str| run::report_progress(progress.as_ref(), s);
-        mesh_with(prepared(surface)?, &options, field, &progress)
+        mesh_with(prepared(surface, &options)?, &options, field, &progress)
     })?;
     Ok(mesh_out(py, mesh, report.to_string()))
 }
@@ -571,7 +590,7 @@ fn mesh_files<'py>(
                     &progress,
                 )?
             }
-            _ => prepared(read_surfaces(&paths, labels)?)?,
+            _ => prepared(read_surfaces(&paths, labels)?, &options)?,
         };
         mesh_with(input, &options, field, &progress)
     })?;
@@ -648,7 +667,10 @@ fn check<'py>(
         }
     };
     guarded(py, threads, move || {
-        let surface = surface.map(prepare).transpose()?.map(|(s, _)| s);
+        let surface = surface
+            .map(|s| prepare(s, false))
+            .transpose()?
+            .map(|(s, _)| s);
         let c = check_mesh(&mesh, surface.as_ref());
         Ok(serde_json::to_string(&c).unwrap_or_default())
     })
@@ -712,7 +734,7 @@ fn recover_surface<'py>(
         "surface".into(),
     )?;
     let (mesh, report) = guarded(py, threads, move || {
-        let (s, _) = prepare(surface)?;
+        let (s, _) = prepare(surface, false)?;
         let opts = RecoverOptions {
             allow_interior_steiner: steiner,
             remove_outside: !keep_outside,
@@ -804,7 +826,10 @@ fn smooth_mesh<'py>(
         _ => None,
     };
     let (mesh, report) = guarded(py, threads, move || {
-        let surface = surface.map(prepare).transpose()?.map(|(s, _)| s);
+        let surface = surface
+            .map(|s| prepare(s, false))
+            .transpose()?
+            .map(|(s, _)| s);
         let mut opts = SmoothOptions {
             boundary: if slide {
                 Boundary::Slide

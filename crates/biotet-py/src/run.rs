@@ -64,9 +64,21 @@ impl Failure {
 
     /// An invalid surface, with the message `biotet validate` prints.
     pub fn invalid(name: &str, e: &SurfaceError) -> Failure {
+        Failure::refused(name, e, true)
+    }
+
+    /// [`Self::invalid`], the way out of crossing triangles said only with `hint` (not where
+    /// the surface stage was asked for, and could not untangle them).
+    pub fn refused(name: &str, e: &SurfaceError, hint: bool) -> Failure {
         Failure {
             kind: Kind::InvalidSurface,
-            message: format!("{name}: invalid surface: {e}"),
+            message: if hint && matches!(e, SurfaceError::SelfIntersection { .. }) {
+                // As the CLI says it.
+                let hint = biotet::surface::untangle::HINT;
+                format!("{name}: invalid surface: {hint}: {e}")
+            } else {
+                format!("{name}: invalid surface: {e}")
+            },
             triangles: e.triangles(),
         }
     }

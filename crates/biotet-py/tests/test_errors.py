@@ -32,6 +32,40 @@ def test_hole_and_crossing_cubes():
         assert max(e.value.triangles) < len(tt)
 
 
+def test_crossing_triangles_are_untangled_by_the_surface_stage():
+    # A flat ellipsoid whose top pole is pushed through its bottom: refused with the way out,
+    # meshed with a surface tolerance (the points moved at most a quarter of it). Two cubes
+    # pushed deep into one another stay refused, saying so.
+    rings, seg = 8, 16  # a UV sphere: poles 0 and 1, rings of `seg` points between
+    th = np.pi * np.arange(1, rings) / rings
+    ph = 2 * np.pi * np.arange(seg) / seg
+    ring = np.stack([np.outer(np.sin(th), np.cos(ph)), np.outer(np.sin(th), np.sin(ph)),
+                     np.outer(np.cos(th), np.ones(seg))], axis=-1).reshape(-1, 3)
+    p = np.vstack([[0, 0, 1], [0, 0, -1], ring]) * [2.0, 2.0, 0.3]
+    at = lambda r, k: 2 + r * seg + k % seg  # noqa: E731
+    t = [[0, at(0, k), at(0, k + 1)] for k in range(seg)]
+    t += [[1, at(rings - 2, k + 1), at(rings - 2, k)] for k in range(seg)]
+    for r in range(rings - 2):
+        for k in range(seg):
+            t += [[at(r, k), at(r + 1, k), at(r + 1, k + 1)], [at(r, k), at(r + 1, k + 1), at(r, k + 1)]]
+    t = np.array(t)
+    p[0, 2] = -0.35  # the north pole pushed through the bottom
+    with pytest.raises(biotet.InvalidSurfaceError) as err:
+        biotet.mesh(p, t)
+    assert "surface_tolerance=D" in str(err.value), str(err.value)
+    m = biotet.mesh(p, t, surface_tolerance=0.5)
+    u = m.report["surface"]["untangled"]
+    assert u["pairs"] > 0 and 0 < u["max_move"] <= 0.125, u
+    assert biotet.check(m)["valid"]
+    q, v = cube((0.5, 0.25, 0.25), 0.5)
+    c, ct = cube()
+    with pytest.raises(biotet.InvalidSurfaceError) as err:
+        biotet.mesh(np.vstack([c, q * [2.0, 1.0, 1.0] - [0.5, 0, 0]]), np.vstack([ct, v + 8]),
+                    surface_tolerance=0.05)
+    assert "self-intersection" in str(err.value), str(err.value)
+    assert "surface_tolerance=D" not in str(err.value), str(err.value)
+
+
 def test_a_turned_triangle_is_turned_back():
     # Orientation means nothing before the nesting gives the regions: the triangle turned
     # against its neighbours is turned back (as `biotet mesh` does, with a note), not refused.

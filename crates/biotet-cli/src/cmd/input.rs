@@ -42,6 +42,7 @@ pub fn side_labelled(
     path: &Path,
     read: biotet_io::SurfaceRead,
     common: Common,
+    crossings: bool,
 ) -> Result<(SurfaceMesh, Vec<Shell>, ValidationReport)> {
     let name = path.display().to_string();
     let mut mesh = read.mesh;
@@ -53,7 +54,10 @@ pub fn side_labelled(
     }
     let partial = mesh.sides.iter().flatten().any(|&l| l == FROM_GEOMETRY);
     let invalid = || format!("{name}: invalid surface");
-    let opts = ValidateOptions::default();
+    let opts = ValidateOptions {
+        self_intersections: !crossings,
+        ..ValidateOptions::default()
+    };
     let mut report = None;
     if partial {
         // Fronts come from the cells, which need triangles that do not cross.
@@ -66,8 +70,13 @@ pub fn side_labelled(
     let mut mesh = resolved.surface;
     let report = match report {
         Some(r) => r,
-        None => validate_surface(&mut mesh, &opts).with_context(invalid)?,
+        None => validate_surface(&mut mesh, &opts)
+            .map_err(|e| refusal(&mesh, e, crossings))
+            .with_context(invalid)?,
     };
+    if crossings {
+        note_crossings(&mesh, &name, common);
+    }
     if !common.quiet && !common.json {
         if report.flipped_inward {
             eprintln!(
@@ -123,8 +132,9 @@ pub fn labelled_surface(
     labels: &[String],
     common: Common,
     stage: &Stage,
+    crossings: bool,
 ) -> Result<(SurfaceMesh, Vec<Shell>, String)> {
-    let (s, shells, _, name) = labelled_surface_report(paths, labels, common, stage)?;
+    let (s, shells, _, name) = labelled_surface_report(paths, labels, common, stage, crossings)?;
     Ok((s, shells, name))
 }
 
@@ -135,6 +145,7 @@ pub fn labelled_surface_report(
     labels: &[String],
     common: Common,
     stage: &Stage,
+    crossings: bool,
 ) -> Result<(SurfaceMesh, Vec<Shell>, ValidationReport, String)> {
     let labels = parse_labels(labels, paths)?;
     let mut parts = Vec::new();
@@ -156,7 +167,7 @@ pub fn labelled_surface_report(
                 );
             }
             stage.set("validating the surface");
-            let (s, shells, report) = side_labelled(p, read, common)?;
+            let (s, shells, report) = side_labelled(p, read, common, crossings)?;
             note_touching(&s, &p.display().to_string(), common);
             return Ok((s, shells, report, p.display().to_string()));
         }
@@ -177,7 +188,7 @@ pub fn labelled_surface_report(
         .collect::<Vec<_>>()
         .join(" + ");
     stage.set("validating the surface");
-    let (s, shells, report) = assemble_validated(parts, &name, paths, common)?;
+    let (s, shells, report) = assemble_validated(parts, &name, paths, common, crossings)?;
     Ok((s, shells, report, name))
 }
 
@@ -188,8 +199,53 @@ pub fn assemble_parts(
     paths: &[PathBuf],
     common: Common,
 ) -> Result<(SurfaceMesh, Vec<Shell>)> {
-    let (s, shells, _) = assemble_validated(parts, name, paths, common)?;
+    let (s, shells, _) = assemble_validated(parts, name, paths, common, false)?;
     Ok((s, shells))
+}
+
+/// A validation error, with the way out added where triangles cross: the surface stage
+/// untangles them.
+fn crossing_hint(e: biotet::mesh::validate::SurfaceError) -> anyhow::Error {
+    if matches!(
+        e,
+        biotet::mesh::validate::SurfaceError::SelfIntersection { .. }
+    ) {
+        anyhow::Error::new(e).context(biotet::surface::untangle::HINT)
+    } else {
+        anyhow::Error::new(e)
+    }
+}
+
+/// A validation error as the user sees it. Where crossing triangles were let through (the
+/// surface stage follows) and the validation failed all the same, the crossings are the cause
+/// to name (shells pushed into one another also confuse their nesting); where they were not,
+/// a crossing's refusal says how the stage untangles them.
+fn refusal(
+    s: &SurfaceMesh,
+    e: biotet::mesh::validate::SurfaceError,
+    crossings: bool,
+) -> anyhow::Error {
+    if crossings {
+        let first = check_self_intersections(s, ValidateOptions::default().max_examples);
+        anyhow::Error::new(first.err().unwrap_or(e))
+    } else {
+        crossing_hint(e)
+    }
+}
+
+/// Tell the user about crossing triangles left for the surface stage to untangle.
+fn note_crossings(s: &SurfaceMesh, name: &str, common: Common) {
+    if common.quiet || common.json {
+        return;
+    }
+    if let Err(biotet::mesh::validate::SurfaceError::SelfIntersection { count, .. }) =
+        check_self_intersections(s, 1)
+    {
+        eprintln!(
+            "note: {name}: {count} pairs of triangles cross; the surface stage untangles them \
+             first, moving points by at most a quarter of the tolerance"
+        );
+    }
 }
 
 /// Tell the user where regions touch only along an edge or at a vertex: legitimate (each
@@ -238,11 +294,20 @@ fn assemble_validated(
     name: &str,
     paths: &[PathBuf],
     common: Common,
+    crossings: bool,
 ) -> Result<(SurfaceMesh, Vec<Shell>, ValidationReport)> {
     let (mut surface, shells) =
         assemble(parts).with_context(|| format!("{name}: cannot assemble the surfaces"))?;
-    let report = validate_surface(&mut surface, &ValidateOptions::default())
+    let opts = ValidateOptions {
+        self_intersections: !crossings,
+        ..ValidateOptions::default()
+    };
+    let report = validate_surface(&mut surface, &opts)
+        .map_err(|e| refusal(&surface, e, crossings))
         .with_context(|| format!("{name}: invalid surface"))?;
+    if crossings {
+        note_crossings(&surface, name, common);
+    }
     if !common.quiet && !common.json {
         for (k, sh) in shells.iter().enumerate() {
             let file = paths
@@ -282,7 +347,7 @@ pub fn surfaces(paths: &[PathBuf], common: Common, stage: &Stage) -> Result<Opti
     if paths.is_empty() {
         return Ok(None);
     }
-    Ok(Some(labelled_surface(paths, &[], common, stage)?.0))
+    Ok(Some(labelled_surface(paths, &[], common, stage, false)?.0))
 }
 
 /// The `n` comma-separated finite numbers of option `--what`'s value `text`.

@@ -230,7 +230,13 @@ pub fn run(a: Args) -> Result<ExitCode> {
         image = Some(summary);
         (s, Vec::new(), input.display().to_string())
     } else {
-        super::input::labelled_surface(&a.surfaces, &a.label, a.common, &stage)?
+        super::input::labelled_surface(
+            &a.surfaces,
+            &a.label,
+            a.common,
+            &stage,
+            a.surface_tolerance.is_some(),
+        )?
     };
     let seconds_read = clock.elapsed().as_secs_f64();
     // Image labels are the image's values (FreeSurfer's 2035 stays 2035); the template holds

@@ -216,6 +216,17 @@ pub fn report_text(r: &SurfaceReport) -> String {
         r.min_fold_out,
         r.n_fold_moves,
     );
+    if let Some(u) = &r.untangled {
+        t += &format!(
+            "  untangled first: {} crossing pairs of input triangles, {} points moved by at most \
+             {} in {} steps (the distances above are to the untangled surface; the bounds \
+             include the move)\n",
+            u.pairs,
+            u.points_moved,
+            length(u.max_move),
+            u.steps
+        );
+    }
     if r.hausdorff_bound > r.tolerance {
         t += &format!(
             "  note: every sample is within the tolerance, but the distance is proven only to \
@@ -257,7 +268,7 @@ pub fn report_text(r: &SurfaceReport) -> String {
 fn run_improve(a: ImproveArgs) -> Result<ExitCode> {
     let stage_ = Stage::start(a.common.quiet, "reading the surface");
     let (surface, _, name) =
-        super::input::labelled_surface(&a.surfaces, &a.label, a.common, &stage_)?;
+        super::input::labelled_surface(&a.surfaces, &a.label, a.common, &stage_, true)?;
     stage_.set("improving the surface");
     let (out, report) = stage(
         &surface,

@@ -36,6 +36,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
             &[],
             a.common,
             &stage,
+            false,
         )?;
         drop(stage);
         if !a.common.quiet && !a.common.json {

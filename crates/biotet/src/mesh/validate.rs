@@ -1814,6 +1814,12 @@ fn improper_pair(s: &SurfaceMesh, i: usize, j: usize) -> bool {
     meet_improperly(&s.corners(i), s.triangles[i], &s.corners(j), s.triangles[j])
 }
 
+/// Every pair `(i, j)`, `i < j`, of triangles that meet improperly (cross, or touch other than
+/// in their shared vertex or edge), sorted.
+pub(crate) fn crossing_pairs(s: &SurfaceMesh) -> Vec<(u32, u32)> {
+    self_intersections(s, usize::MAX / 8).1
+}
+
 /// The number of improperly intersecting pairs and the `k` lowest ones `(i, j)`, `i < j`.
 fn self_intersections(s: &SurfaceMesh, k: usize) -> (usize, Vec<(u32, u32)>) {
     let boxes: Vec<Aabb> = (0..s.triangles.len())

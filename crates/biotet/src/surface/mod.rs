@@ -33,6 +33,7 @@ mod measure;
 pub mod presplit;
 pub mod remesh;
 pub mod size;
+pub mod untangle;
 
 use std::time::Instant;
 
@@ -195,6 +196,11 @@ pub struct SurfaceReport {
     pub seconds_repair: f64,
     /// Seconds of the first validation and measure.
     pub seconds_measure: f64,
+    /// Crossing triangles in the input, untangled first ([`untangle`]): the stage then ran on
+    /// the untangled surface with the tolerance less its largest move, and the distances above
+    /// are to the untangled surface (the bounds include the move, so they bound the distance
+    /// to the input). `None` when nothing crossed.
+    pub untangled: Option<untangle::Untangled>,
 }
 
 /// Why [`improve`] failed.
@@ -206,6 +212,9 @@ pub enum SurfaceError {
     /// The input is not a valid surface.
     #[error("surface stage: invalid input surface: {0}")]
     Input(validate::SurfaceError),
+    /// The input's crossing triangles could not be untangled within the tolerance's share.
+    #[error("surface stage: cannot untangle the input's crossing triangles: {0}")]
+    Crossings(untangle::UntangleError),
     /// The remeshed surface did not validate (a bug: every operation is checked).
     #[error("surface stage: the improved surface is invalid: {0}")]
     Output(validate::SurfaceError),
@@ -226,6 +235,9 @@ pub enum SurfaceError {
         out_to_in: f64,
     },
 }
+
+/// The share of the tolerance that untangling crossing triangles may use ([`untangle`]).
+pub const UNTANGLE_SHARE: f64 = 0.25;
 
 /// The median edge length of a surface.
 pub fn median_edge_length(s: &SurfaceMesh) -> f64 {
@@ -345,6 +357,26 @@ pub fn improve_with_progress(
     .map_err(SurfaceError::Input)?;
     if opts.orient_sheets {
         orient_sheets(&mut input);
+    }
+    // Crossing triangles (a FreeSurfer surface's few): untangled within a share of the
+    // tolerance, the rest of it left to the remeshing, so the output stays within D of the input.
+    if !validate::crossing_pairs(&input).is_empty() {
+        progress("untangling crossing triangles");
+        let (untangled, u) =
+            untangle::untangle(&input, UNTANGLE_SHARE * d).map_err(SurfaceError::Crossings)?;
+        let inner = SurfaceOptions {
+            tolerance: d - u.max_move,
+            orient_sheets: false,
+            ..opts.clone()
+        };
+        let (out, mut report) = improve_with_progress(&untangled, &inner, progress)?;
+        report.tolerance = d;
+        report.hausdorff_bound += u.max_move;
+        report.hausdorff_bound_in_to_out += u.max_move;
+        report.hausdorff_bound_out_to_in += u.max_move;
+        report.seconds = clock.elapsed().as_secs_f64();
+        report.untangled = Some(u);
+        return Ok((out, report));
     }
     let surface = &input;
     let l = match opts.edge_length {
@@ -476,6 +508,7 @@ pub fn improve_with_progress(
         seconds_remesh,
         seconds_repair,
         seconds_measure,
+        untangled: None,
     };
     Ok((out, report))
 }
