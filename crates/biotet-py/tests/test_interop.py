@@ -92,11 +92,16 @@ def test_surfaces_pyvista_writes_mesh(tmp_path, cli):
         c = biotet.check(m, s)
         assert c["valid"] and c["surface"]["n_missing"] == 0, (name, c)
     for ext in ("vtp", "vtk"):
+        # Converted as it is: no labels (none were read); with --regions, its one region's.
         out = tmp_path / f"back.{ext}"
         r = run_cli(cli, "convert", tmp_path / "polys.vtp", "-o", out)
         assert r.returncode == 0, r.stderr
         back = pv.read(out)
         assert back.n_cells == sphere.n_cells, ext
+        assert "sides" not in back.cell_data, ext
+        r = run_cli(cli, "convert", tmp_path / "polys.vtp", "--regions", "-o", out)
+        assert r.returncode == 0, r.stderr
+        back = pv.read(out)
         sides = np.asarray(back.cell_data["sides"])
         assert np.array_equal(sides, np.tile([1, 0], (back.n_cells, 1))), ext
 
