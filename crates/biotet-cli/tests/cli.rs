@@ -1653,6 +1653,30 @@ fn crossing_triangles_are_refused_with_the_way_out_and_untangled_by_the_surface_
 }
 
 #[test]
+fn a_freesurfer_surface_meshes_by_its_name() {
+    // `lh.pial` as a subject's surf/ holds it: no format extension, known by its first bytes;
+    // `convert` writes one as .surf.
+    let dir = tempfile::tempdir().unwrap();
+    let off = dir.path().join("e.off");
+    std::fs::write(&off, ellipsoid_off([1.0, 2.0, 3.0], [1.0, 0.8, 0.6])).unwrap();
+    let pial = dir.path().join("lh.pial");
+    let mut bytes = Vec::new();
+    let e = biotet_io::read_surface(&off).unwrap().mesh;
+    biotet_io::freesurfer::write(&mut bytes, &e, "lh.pial").unwrap();
+    std::fs::write(&pial, bytes).unwrap();
+    let out = dir.path().join("lh.vtu");
+    let j = json_of(&biotet(&["mesh", s(&pial), "-o", s(&out), "--json"]));
+    assert_eq!(j["pipeline"]["missing_triangles"], 0, "{j}");
+    let c = biotet(&["check", s(&out), "--surface", s(&pial), "-q"]);
+    assert!(c.status.success(), "{}", stderr(&c));
+    let surf = dir.path().join("back.surf");
+    let c = biotet(&["convert", s(&off), "-o", s(&surf)]);
+    assert!(c.status.success(), "{}", stderr(&c));
+    let r = biotet_io::read_surface(&surf).unwrap().mesh;
+    assert_eq!(r.triangles, e.triangles);
+}
+
+#[test]
 fn a_surface_far_from_the_origin_meshes() {
     // An ellipsoid at (1e9, -2e9, 3e9) (survey or micrometre coordinates): the memory estimate
     // summed cones from the origin, whose terms cancelled to noise a million times the volume,

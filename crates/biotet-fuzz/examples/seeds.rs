@@ -41,6 +41,7 @@ fn main() {
         ("vtu", SurfaceFormat::Vtu, "vtu_surface"),
         ("vtp", SurfaceFormat::Vtp, "vtp_surface"),
         ("vtk", SurfaceFormat::Vtk, "vtk_surface"),
+        ("surf", SurfaceFormat::FreeSurfer, "freesurfer_surface"),
     ] {
         for (name, m) in [("ico", &tet4), ("cube", &cube)] {
             let p = tmp.join(format!("{name}_{f:?}.{ext}"));

@@ -41,6 +41,7 @@ pub mod atomic;
 mod b64;
 mod common;
 pub mod error;
+pub mod freesurfer;
 pub mod gmsh;
 pub mod grid;
 pub mod image;
@@ -166,6 +167,9 @@ pub enum SurfaceFormat {
     Vtp,
     /// Legacy VTK `.vtk` (read: [`vtk`]; written binary, `POLYDATA` with `sides`).
     Vtk,
+    /// A FreeSurfer triangle surface (`lh.pial`, `rh.white`, …; recognised by its first bytes,
+    /// or named `.surf`; see [`freesurfer`]).
+    FreeSurfer,
 }
 
 /// Tet mesh file formats.
@@ -199,12 +203,14 @@ pub enum TriFormat {
 }
 
 /// Supported surface extensions, for messages.
-pub const SURFACE_EXTENSIONS: &str = ".stl, .obj, .off, .ply, .mesh, .vtu, .vtp, .vtk";
+pub const SURFACE_EXTENSIONS: &str =
+    ".stl, .obj, .off, .ply, .mesh, .vtu, .vtp, .vtk, .surf or a FreeSurfer surface (lh.pial)";
 /// Supported tet mesh extensions, for messages.
 pub const TET_EXTENSIONS: &str = ".vtu, .vtk, .mesh, .msh, .node/.ele (TetGen)";
 /// Supported 2D mesh extensions, for messages.
 pub const TRI_EXTENSIONS: &str = ".mesh, .node/.ele (Triangle); writing also .vtu, .msh";
-const ALL_EXTENSIONS: &str = ".stl, .obj, .off, .ply, .mesh, .vtu, .vtp, .vtk, .msh, .node, .ele";
+const ALL_EXTENSIONS: &str = ".stl, .obj, .off, .ply, .mesh, .vtu, .vtp, .vtk, .msh, .node, .ele, \
+                              .surf or a FreeSurfer surface (lh.pial)";
 
 /// The lower-case extension of a path.
 fn ext(path: &Path) -> String {
@@ -230,6 +236,8 @@ impl SurfaceFormat {
             "vtu" => SurfaceFormat::Vtu,
             "vtp" => SurfaceFormat::Vtp,
             "vtk" => SurfaceFormat::Vtk,
+            "surf" => SurfaceFormat::FreeSurfer,
+            _ if starts_freesurfer(path) => SurfaceFormat::FreeSurfer,
             _ => {
                 return Err(Error::UnknownExtension {
                     path: name(path),
@@ -286,7 +294,7 @@ impl TriFormat {
 /// `.node`/`.ele` files (the dimension in the `.node` header).
 pub fn mesh_kind(path: &Path) -> Result<MeshKind> {
     match ext(path).as_str() {
-        "stl" | "obj" | "off" | "ply" | "vtp" => Ok(MeshKind::Surface),
+        "stl" | "obj" | "off" | "ply" | "vtp" | "surf" => Ok(MeshKind::Surface),
         "msh" => Ok(MeshKind::Tetrahedra),
         // Unreadable: by extension; reading it will say why.
         "vtu" => match atomic::read_file(path) {
@@ -305,12 +313,23 @@ pub fn mesh_kind(path: &Path) -> Result<MeshKind> {
                 _ => Ok(MeshKind::Tetrahedra),
             }
         }
+        _ if starts_freesurfer(path) => Ok(MeshKind::Surface),
         _ => Err(Error::UnknownExtension {
             path: name(path),
             kind: "mesh",
             supported: ALL_EXTENSIONS,
         }),
     }
+}
+
+/// Whether the file at `path` starts as a FreeSurfer surface does (their names, `lh.pial`,
+/// carry no format extension).
+fn starts_freesurfer(path: &Path) -> bool {
+    use std::io::Read;
+    let mut head = [0u8; 3];
+    std::fs::File::open(path)
+        .and_then(|mut f| f.read_exact(&mut head))
+        .is_ok_and(|_| freesurfer::is_freesurfer(&head))
 }
 
 /// Read a surface, choosing the format by extension.
@@ -331,6 +350,7 @@ pub fn read_surface_as(path: &Path, format: SurfaceFormat) -> Result<SurfaceRead
         SurfaceFormat::Vtu => vtu::parse_surface(&data, &n),
         SurfaceFormat::Vtp => vtp::parse_surface(&data, &n),
         SurfaceFormat::Vtk => vtk::parse_surface(&data, &n),
+        SurfaceFormat::FreeSurfer => freesurfer::parse(&data, &n),
     }
 }
 
@@ -355,6 +375,7 @@ pub fn write_surface_as(path: &Path, mesh: &SurfaceMesh, format: SurfaceFormat) 
         SurfaceFormat::Vtu => vtu::write_surface(w, mesh, &n),
         SurfaceFormat::Vtp => vtp::write_surface(w, mesh, &n),
         SurfaceFormat::Vtk => vtk_out::write_surface(w, mesh, &n),
+        SurfaceFormat::FreeSurfer => freesurfer::write(w, mesh, &n),
     })
 }
 

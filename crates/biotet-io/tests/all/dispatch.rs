@@ -41,6 +41,27 @@ fn kinds_by_extension_and_content() {
         mesh_kind(&dir.path().join("tg.node")).unwrap(),
         MeshKind::Tetrahedra
     );
+    // A FreeSurfer surface is known by its first bytes, whatever its name (`lh.pial`), or by
+    // `.surf`; a file of another kind under such a name is not taken for one.
+    for name in ["lh.pial", "rh.white.preaparc", "s.surf"] {
+        let p = dir.path().join(name);
+        let mut bytes = Vec::new();
+        biotet_io::freesurfer::write(&mut bytes, &box_surface(1, 1.0), name).unwrap();
+        std::fs::write(&p, bytes).unwrap();
+        assert_eq!(mesh_kind(&p).unwrap(), MeshKind::Surface, "{name}");
+        let r = biotet_io::read_surface(&p).unwrap();
+        assert_eq!(r.mesh.triangles, box_surface(1, 1.0).triangles, "{name}");
+    }
+    let curv = dir.path().join("lh.thickness");
+    std::fs::write(&curv, b"\xff\xff\xff\0\0\0\x01").unwrap();
+    assert!(mesh_kind(&curv).is_err());
+    let named = dir.path().join("thickness.surf");
+    std::fs::write(&named, b"\xff\xff\xff\0\0\0\x01").unwrap();
+    let e = biotet_io::read_surface(&named).unwrap_err().to_string();
+    assert!(e.contains("curvature"), "{e}");
+    let text = dir.path().join("notes.pial");
+    std::fs::write(&text, b"not a surface").unwrap();
+    assert!(mesh_kind(&text).is_err());
     // A tet .mesh read as a surface gives its boundary triangles.
     let r = biotet_io::read_surface(&tet).unwrap();
     assert!(r.mesh.triangles.len() >= 12);
@@ -54,7 +75,7 @@ fn unknown_extensions_list_the_supported_ones() {
     assert_eq!(
         e,
         "foo.xyz: unknown surface file extension; supported: .stl, .obj, .off, .ply, .mesh, .vtu, \
-         .vtp, .vtk"
+         .vtp, .vtk, .surf or a FreeSurfer surface (lh.pial)"
     );
     let e = biotet_io::write_tet_mesh(Path::new("foo"), &cube6())
         .unwrap_err()
