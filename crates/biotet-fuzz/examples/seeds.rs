@@ -42,6 +42,7 @@ fn main() {
         ("vtp", SurfaceFormat::Vtp, "vtp_surface"),
         ("vtk", SurfaceFormat::Vtk, "vtk_surface"),
         ("surf", SurfaceFormat::FreeSurfer, "freesurfer_surface"),
+        ("gii", SurfaceFormat::Gifti, "gifti_surface"),
     ] {
         for (name, m) in [("ico", &tet4), ("cube", &cube)] {
             let p = tmp.join(format!("{name}_{f:?}.{ext}"));

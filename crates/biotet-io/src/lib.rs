@@ -42,6 +42,7 @@ mod b64;
 mod common;
 pub mod error;
 pub mod freesurfer;
+pub mod gifti;
 pub mod gmsh;
 pub mod grid;
 pub mod image;
@@ -167,6 +168,8 @@ pub enum SurfaceFormat {
     Vtp,
     /// Legacy VTK `.vtk` (read: [`vtk`]; written binary, `POLYDATA` with `sides`).
     Vtk,
+    /// GIfTI `.gii` (`.surf.gii`; see [`gifti`]).
+    Gifti,
     /// A FreeSurfer triangle surface (`lh.pial`, `rh.white`, …; recognised by its first bytes,
     /// or named `.surf`; see [`freesurfer`]).
     FreeSurfer,
@@ -203,14 +206,13 @@ pub enum TriFormat {
 }
 
 /// Supported surface extensions, for messages.
-pub const SURFACE_EXTENSIONS: &str =
-    ".stl, .obj, .off, .ply, .mesh, .vtu, .vtp, .vtk, .surf or a FreeSurfer surface (lh.pial)";
+pub const SURFACE_EXTENSIONS: &str = ".stl, .obj, .off, .ply, .mesh, .vtu, .vtp, .vtk, .gii, .surf or a FreeSurfer surface (lh.pial)";
 /// Supported tet mesh extensions, for messages.
 pub const TET_EXTENSIONS: &str = ".vtu, .vtk, .mesh, .msh, .node/.ele (TetGen)";
 /// Supported 2D mesh extensions, for messages.
 pub const TRI_EXTENSIONS: &str = ".mesh, .node/.ele (Triangle); writing also .vtu, .msh";
 const ALL_EXTENSIONS: &str = ".stl, .obj, .off, .ply, .mesh, .vtu, .vtp, .vtk, .msh, .node, .ele, \
-                              .surf or a FreeSurfer surface (lh.pial)";
+                              .gii, .surf or a FreeSurfer surface (lh.pial)";
 
 /// The lower-case extension of a path.
 fn ext(path: &Path) -> String {
@@ -237,6 +239,7 @@ impl SurfaceFormat {
             "vtp" => SurfaceFormat::Vtp,
             "vtk" => SurfaceFormat::Vtk,
             "surf" => SurfaceFormat::FreeSurfer,
+            "gii" => SurfaceFormat::Gifti,
             _ if starts_freesurfer(path) => SurfaceFormat::FreeSurfer,
             _ => {
                 return Err(Error::UnknownExtension {
@@ -294,7 +297,7 @@ impl TriFormat {
 /// `.node`/`.ele` files (the dimension in the `.node` header).
 pub fn mesh_kind(path: &Path) -> Result<MeshKind> {
     match ext(path).as_str() {
-        "stl" | "obj" | "off" | "ply" | "vtp" | "surf" => Ok(MeshKind::Surface),
+        "stl" | "obj" | "off" | "ply" | "vtp" | "surf" | "gii" => Ok(MeshKind::Surface),
         "msh" => Ok(MeshKind::Tetrahedra),
         // Unreadable: by extension; reading it will say why.
         "vtu" => match atomic::read_file(path) {
@@ -351,6 +354,7 @@ pub fn read_surface_as(path: &Path, format: SurfaceFormat) -> Result<SurfaceRead
         SurfaceFormat::Vtp => vtp::parse_surface(&data, &n),
         SurfaceFormat::Vtk => vtk::parse_surface(&data, &n),
         SurfaceFormat::FreeSurfer => freesurfer::parse(&data, &n),
+        SurfaceFormat::Gifti => gifti::parse(&data, &n),
     }
 }
 
@@ -376,6 +380,7 @@ pub fn write_surface_as(path: &Path, mesh: &SurfaceMesh, format: SurfaceFormat) 
         SurfaceFormat::Vtp => vtp::write_surface(w, mesh, &n),
         SurfaceFormat::Vtk => vtk_out::write_surface(w, mesh, &n),
         SurfaceFormat::FreeSurfer => freesurfer::write(w, mesh, &n),
+        SurfaceFormat::Gifti => gifti::write(w, mesh, &n),
     })
 }
 

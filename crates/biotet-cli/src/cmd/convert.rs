@@ -22,7 +22,7 @@ pub struct Args {
     /// Input mesh; its format is chosen by extension.
     input: PathBuf,
     /// Output mesh; its format is chosen by extension (.vtu .vtk .mesh .msh .node/.ele for tets;
-    /// .vtu .mesh .msh .node/.ele for 2D triangles; .stl .obj .off .ply .mesh .vtu .vtp .vtk .surf for
+    /// .vtu .mesh .msh .node/.ele for 2D triangles; .stl .obj .off .ply .mesh .vtu .vtp .vtk .gii .surf for
     /// surfaces).
     #[arg(short, long, value_name = "OUT")]
     output: PathBuf,
@@ -46,7 +46,8 @@ pub fn run(a: Args) -> Result<ExitCode> {
         .extension()
         .map(|e| e.to_string_lossy().to_lowercase())
         .unwrap_or_default();
-    let surface_ext = ["stl", "obj", "off", "ply", "vtp", "surf"].contains(&out_ext.as_str());
+    let surface_ext =
+        ["stl", "obj", "off", "ply", "vtp", "surf", "gii"].contains(&out_ext.as_str());
     if surface_ext && kind != MeshKind::Surface {
         anyhow::bail!(
             "{}: cannot write a volume or 2D mesh as a surface (.{out_ext}); \
@@ -56,7 +57,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
     }
     if kind == MeshKind::Surface && ["msh", "node", "ele"].contains(&out_ext.as_str()) {
         anyhow::bail!(
-            "{}: {} is a surface; write it as .stl, .obj, .off, .ply, .mesh, .vtu, .vtp, .vtk or .surf \
+            "{}: {} is a surface; write it as .stl, .obj, .off, .ply, .mesh, .vtu, .vtp, .vtk, .gii or .surf \
              (meshing a surface is `biotet mesh`, coming with the mesher)",
             a.output.display(),
             a.input.display()

@@ -50,8 +50,8 @@ Examples:
 #[command(group(clap::ArgGroup::new("sizing").args(["size", "size_from_surface", "size_field"])))]
 #[command(after_help = EXAMPLES)]
 pub struct Args {
-    /// Closed surfaces (.stl, .obj, .off, .ply, .mesh, .vtu, .vtp, .vtk, FreeSurfer surfaces such
-    /// as lh.pial). Every closed shell encloses a region; a point belongs to the innermost shell around it. Shells are labelled 1,
+    /// Closed surfaces (.stl, .obj, .off, .ply, .mesh, .vtu, .vtp, .vtk, .gii, FreeSurfer surfaces
+    /// such as lh.pial). Every closed shell encloses a region; a point belongs to the innermost shell around it. Shells are labelled 1,
     /// 2, … in order of files and of shells within a file, unless --label says otherwise. Without a
     /// surface, the bundled brain example is meshed. A 2D planar straight-line graph (.poly,
     /// .node/.edge, or a Dimension 2 .mesh with Edges) is meshed in 2D (see docs/commands.md, "2D

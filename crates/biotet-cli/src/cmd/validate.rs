@@ -16,7 +16,7 @@ Examples:
 #[derive(clap::Args)]
 #[command(after_help = EXAMPLES)]
 pub struct Args {
-    /// Surfaces: .stl .obj .off .ply .mesh .vtu .vtp .vtk, FreeSurfer surfaces (lh.pial).
+    /// Surfaces: .stl .obj .off .ply .mesh .vtu .vtp .vtk .gii, FreeSurfer surfaces (lh.pial).
     #[arg(required = true)]
     surfaces: Vec<PathBuf>,
     #[command(flatten)]

@@ -43,6 +43,13 @@ fn kinds_by_extension_and_content() {
     );
     // A FreeSurfer surface is known by its first bytes, whatever its name (`lh.pial`), or by
     // `.surf`; a file of another kind under such a name is not taken for one.
+    let gii = dir.path().join("sub-01_hemi-L_pial.surf.gii");
+    biotet_io::write_surface(&gii, &box_surface(1, 1.0)).unwrap();
+    assert_eq!(mesh_kind(&gii).unwrap(), MeshKind::Surface);
+    assert_eq!(
+        biotet_io::read_surface(&gii).unwrap().mesh.points,
+        box_surface(1, 1.0).points
+    );
     for name in ["lh.pial", "rh.white.preaparc", "s.surf"] {
         let p = dir.path().join(name);
         let mut bytes = Vec::new();
@@ -75,7 +82,7 @@ fn unknown_extensions_list_the_supported_ones() {
     assert_eq!(
         e,
         "foo.xyz: unknown surface file extension; supported: .stl, .obj, .off, .ply, .mesh, .vtu, \
-         .vtp, .vtk, .surf or a FreeSurfer surface (lh.pial)"
+         .vtp, .vtk, .gii, .surf or a FreeSurfer surface (lh.pial)"
     );
     let e = biotet_io::write_tet_mesh(Path::new("foo"), &cube6())
         .unwrap_err()
