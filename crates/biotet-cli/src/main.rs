@@ -158,7 +158,11 @@ fn main() -> ExitCode {
                 .downcast_ref::<biotet::mesh::validate::SurfaceError>()
                 .is_some()
                 || e.downcast_ref::<biotet::mesh::side_labels::SideLabelError>()
-                    .is_some();
+                    .is_some()
+                || matches!(
+                    e.downcast_ref::<biotet::surface::SurfaceError>(),
+                    Some(biotet::surface::SurfaceError::Crossings(_))
+                );
             ExitCode::from(if refused { EXIT_INVALID } else { EXIT_ERROR })
         }
     }

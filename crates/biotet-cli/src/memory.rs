@@ -194,9 +194,12 @@ fn extent(
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     // The inside volume: triangles with the outside on one side only (interfaces add nothing).
-    // Cones from a point of the surface, not the origin: far from it (coordinates of 1e9) the
+    // Cones from a corner of the surface, not the origin: far from it (coordinates of 1e9) the
     // terms would cancel to noise larger than the volume.
-    let o = surface.points.first().copied().unwrap_or([0.0; 3]);
+    let o = surface
+        .triangles
+        .first()
+        .map_or([0.0; 3], |t| surface.points[t[0] as usize]);
     let mut volume = 0.0;
     for (t, s) in surface.triangles.iter().zip(&surface.sides) {
         let [a, b, c] = t.map(|v| surface.points[v as usize]);

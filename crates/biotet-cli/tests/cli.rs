@@ -1653,7 +1653,7 @@ fn crossing_triangles_are_refused_with_the_way_out_and_untangled_by_the_surface_
 }
 
 #[test]
-fn a_freesurfer_surface_meshes_by_its_name() {
+fn freesurfer_and_gifti_surfaces_mesh() {
     // `lh.pial` as a subject's surf/ holds it: no format extension, known by its first bytes;
     // `convert` writes one as .surf.
     let dir = tempfile::tempdir().unwrap();
@@ -1674,6 +1674,16 @@ fn a_freesurfer_surface_meshes_by_its_name() {
     assert!(c.status.success(), "{}", stderr(&c));
     let r = biotet_io::read_surface(&surf).unwrap().mesh;
     assert_eq!(r.triangles, e.triangles);
+    // GIfTI, as fMRIPrep names it: meshed to the OFF's file byte for byte (float64 points).
+    let gii = dir.path().join("sub-01_hemi-L_pial.surf.gii");
+    let c = biotet(&["convert", s(&off), "-o", s(&gii)]);
+    assert!(c.status.success(), "{}", stderr(&c));
+    let (a, b) = (dir.path().join("a.vtu"), dir.path().join("b.vtu"));
+    for (input, out) in [(&off, &a), (&gii, &b)] {
+        let m = biotet(&["mesh", s(input), "-o", s(out), "--threads", "1", "-q"]);
+        assert!(m.status.success(), "{}", stderr(&m));
+    }
+    assert!(std::fs::read(&a).unwrap() == std::fs::read(&b).unwrap());
 }
 
 #[test]

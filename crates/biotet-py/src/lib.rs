@@ -158,12 +158,26 @@ struct Prepared {
     image: Option<ImageSummary>,
 }
 
+/// What a surface's validation does with crossing triangles (as the CLI's `input::Crossings`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Crossings {
+    /// Refused (no way to untangle them here: `check`, `recover`, `smooth`).
+    Refused,
+    /// Refused, the message naming `surface_tolerance`, which untangles them.
+    Hinted,
+    /// Let through: the surface stage follows and untangles them.
+    Allowed,
+}
+
 /// Validate a labelled surface as `biotet mesh` does: shells assembled and labelled innermost
-/// first, or the file's own side labels resolved against the geometry. With `crossings`
-/// (the surface stage follows, which untangles them), crossing triangles are let through.
-fn prepare(surface: Surface, crossings: bool) -> Result<(SurfaceMesh, serde_json::Value), Failure> {
+/// first, or the file's own side labels resolved against the geometry (a file giving only one
+/// side's labels needs triangles that do not cross: its fronts come from the cells).
+fn prepare(
+    surface: Surface,
+    crossings: Crossings,
+) -> Result<(SurfaceMesh, serde_json::Value), Failure> {
     let opts = ValidateOptions {
-        self_intersections: !crossings,
+        self_intersections: crossings != Crossings::Allowed,
         ..ValidateOptions::default()
     };
     match surface {
@@ -185,7 +199,15 @@ fn prepare(surface: Surface, crossings: bool) -> Result<(SurfaceMesh, serde_json
                 .iter()
                 .flatten()
                 .any(|&l| l == side_labels::FROM_GEOMETRY);
-            if !partial {
+            if partial {
+                let hint = if crossings == Crossings::Allowed {
+                    Crossings::Refused
+                } else {
+                    crossings
+                };
+                check_self_intersections(&s, opts.max_examples)
+                    .map_err(|e| refusal(&s, &name, e, hint))?;
+            } else {
                 validate_surface(&mut s, &opts).map_err(|e| refusal(&s, &name, e, crossings))?;
             }
             let resolved = side_labels::resolve(&s).map_err(|e| {
@@ -202,14 +224,16 @@ fn prepare(surface: Surface, crossings: bool) -> Result<(SurfaceMesh, serde_json
 }
 
 /// A validation error as the CLI says it: where crossing triangles were let through and the
-/// validation failed all the same, the crossings named as the cause, without the way out (the
-/// stage was asked for); else as it is, a crossing's with the way out.
-fn refusal(s: &SurfaceMesh, name: &str, e: SurfaceError, crossings: bool) -> Failure {
-    if crossings {
-        let first = check_self_intersections(s, ValidateOptions::default().max_examples);
-        Failure::refused(name, &first.err().unwrap_or(e), false)
-    } else {
-        Failure::invalid(name, &e)
+/// nesting failed all the same, the crossings named as the cause; a crossing's refusal with the
+/// way out where that was asked for; else as it is.
+fn refusal(s: &SurfaceMesh, name: &str, e: SurfaceError, crossings: Crossings) -> Failure {
+    match crossings {
+        Crossings::Allowed if matches!(e, SurfaceError::LabelsContradictGeometry { .. }) => {
+            let first = check_self_intersections(s, ValidateOptions::default().max_examples);
+            Failure::refused(name, &first.err().unwrap_or(e), false)
+        }
+        Crossings::Hinted => Failure::refused(name, &e, true),
+        _ => Failure::refused(name, &e, false),
     }
 }
 
@@ -288,9 +312,19 @@ fn mesh_with(
                 // A bad option is the caller's value; the error names the stage itself.
                 let kind = match e {
                     biotet::surface::SurfaceError::Options(_) => Kind::Value,
+                    // Crossings the untangling cannot remove: the input, as the CLI judges it.
+                    biotet::surface::SurfaceError::Crossings(_) => Kind::InvalidSurface,
                     _ => Kind::Meshing,
                 };
-                Failure::new(kind, format!("{name}: {e}"))
+                let triangles = match &e {
+                    biotet::surface::SurfaceError::Crossings(u) => vec![u.first.0, u.first.1],
+                    _ => Vec::new(),
+                };
+                Failure {
+                    kind,
+                    message: format!("{name}: {e}"),
+                    triangles,
+                }
             })?;
             (s, Some(r))
         }
@@ -421,7 +455,12 @@ fn mesh_with(
 /// when `o` asks for the surface stage, which untangles them).
 fn prepared(surface: Surface, o: &MeshOptions) -> Result<Prepared, Failure> {
     let name = surface.name().to_string();
-    let (surface, shells) = prepare(surface, o.surface_tolerance.is_some())?;
+    let crossings = if o.surface_tolerance.is_some() {
+        Crossings::Allowed
+    } else {
+        Crossings::Hinted
+    };
+    let (surface, shells) = prepare(surface, crossings)?;
     Ok(Prepared {
         surface,
         shells,
@@ -668,7 +707,7 @@ fn check<'py>(
     };
     guarded(py, threads, move || {
         let surface = surface
-            .map(|s| prepare(s, false))
+            .map(|s| prepare(s, Crossings::Refused))
             .transpose()?
             .map(|(s, _)| s);
         let c = check_mesh(&mesh, surface.as_ref());
@@ -734,7 +773,7 @@ fn recover_surface<'py>(
         "surface".into(),
     )?;
     let (mesh, report) = guarded(py, threads, move || {
-        let (s, _) = prepare(surface, false)?;
+        let (s, _) = prepare(surface, Crossings::Refused)?;
         let opts = RecoverOptions {
             allow_interior_steiner: steiner,
             remove_outside: !keep_outside,
@@ -827,7 +866,7 @@ fn smooth_mesh<'py>(
     };
     let (mesh, report) = guarded(py, threads, move || {
         let surface = surface
-            .map(|s| prepare(s, false))
+            .map(|s| prepare(s, Crossings::Refused))
             .transpose()?
             .map(|(s, _)| s);
         let mut opts = SmoothOptions {

@@ -62,13 +62,8 @@ impl Failure {
         }
     }
 
-    /// An invalid surface, with the message `biotet validate` prints.
-    pub fn invalid(name: &str, e: &SurfaceError) -> Failure {
-        Failure::refused(name, e, true)
-    }
-
-    /// [`Self::invalid`], the way out of crossing triangles said only with `hint` (not where
-    /// the surface stage was asked for, and could not untangle them).
+    /// An invalid surface, with the message `biotet validate` prints; with `hint` the way out
+    /// of crossing triangles said (the surface stage untangles them) where they are the reason.
     pub fn refused(name: &str, e: &SurfaceError, hint: bool) -> Failure {
         Failure {
             kind: Kind::InvalidSurface,

@@ -52,7 +52,16 @@ pub fn run(a: Args) -> Result<ExitCode> {
     let surface = if a.surfaces.is_empty() {
         None
     } else {
-        Some(super::input::labelled_surface(&a.surfaces, &a.label, a.common, &stage, false)?.0)
+        Some(
+            super::input::labelled_surface(
+                &a.surfaces,
+                &a.label,
+                a.common,
+                &stage,
+                super::input::Crossings::Refused,
+            )?
+            .0,
+        )
     };
     stage.set("checking");
     let report = biotet::check::check(&mesh, surface.as_ref());

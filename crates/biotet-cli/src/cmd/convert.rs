@@ -86,7 +86,13 @@ pub fn run(a: Args) -> Result<ExitCode> {
                     .any(|&l| l == biotet::mesh::side_labels::FROM_GEOMETRY)
             });
             let m = if read.side_labels.is_some() && (partial || a.regions) {
-                super::input::side_labelled(&a.input, read, a.common, false)?.0
+                super::input::side_labelled(
+                    &a.input,
+                    read,
+                    a.common,
+                    super::input::Crossings::Refused,
+                )?
+                .0
             } else if let Some(sides) = read.side_labels {
                 SurfaceMesh { sides, ..read.mesh }
             } else if a.regions {

@@ -11,6 +11,29 @@ use biotet::mesh::validate::{
 use biotet::{SurfaceMesh, TetMesh};
 use std::path::{Path, PathBuf};
 
+/// What a surface's validation does with crossing triangles.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Crossings {
+    /// Refused (a command that needs a valid surface and has no way to untangle it).
+    Refused,
+    /// Refused, the message naming `--surface-tolerance`, which untangles them (`validate`,
+    /// `mesh` without it).
+    Hinted,
+    /// Let through: the surface stage follows and untangles them.
+    Allowed,
+}
+
+impl Crossings {
+    /// `Allowed` when the surface stage will run, else `Hinted`.
+    pub fn unless_staged(staged: bool) -> Crossings {
+        if staged {
+            Crossings::Allowed
+        } else {
+            Crossings::Hinted
+        }
+    }
+}
+
 /// Read a tet mesh, telling the user about tets that had to be reoriented.
 pub fn tet_mesh(path: &Path, common: Common) -> Result<TetMesh> {
     let read = biotet_io::read_tet_mesh(path)?;
@@ -42,7 +65,7 @@ pub fn side_labelled(
     path: &Path,
     read: biotet_io::SurfaceRead,
     common: Common,
-    crossings: bool,
+    crossings: Crossings,
 ) -> Result<(SurfaceMesh, Vec<Shell>, ValidationReport)> {
     let name = path.display().to_string();
     let mut mesh = read.mesh;
@@ -55,15 +78,26 @@ pub fn side_labelled(
     let partial = mesh.sides.iter().flatten().any(|&l| l == FROM_GEOMETRY);
     let invalid = || format!("{name}: invalid surface");
     let opts = ValidateOptions {
-        self_intersections: !crossings,
+        self_intersections: crossings != Crossings::Allowed,
         ..ValidateOptions::default()
     };
     let mut report = None;
     if partial {
-        // Fronts come from the cells, which need triangles that do not cross.
-        check_self_intersections(&mesh, opts.max_examples).with_context(invalid)?;
+        // Fronts come from the cells, which need triangles that do not cross, even where the
+        // surface stage would untangle them after.
+        let hint = if crossings == Crossings::Allowed {
+            Crossings::Refused
+        } else {
+            crossings
+        };
+        check_self_intersections(&mesh, opts.max_examples)
+            .map_err(|e| refusal(&mesh, e, hint))
+            .with_context(invalid)?;
     } else {
-        report = Some(validate_surface(&mut mesh, &opts).with_context(invalid)?);
+        let r = validate_surface(&mut mesh, &opts)
+            .map_err(|e| refusal(&mesh, e, crossings))
+            .with_context(invalid)?;
+        report = Some(r);
     }
     let resolved = side_labels::resolve(&mesh)
         .with_context(|| format!("{name}: side labels disagree with the geometry"))?;
@@ -74,7 +108,7 @@ pub fn side_labelled(
             .map_err(|e| refusal(&mesh, e, crossings))
             .with_context(invalid)?,
     };
-    if crossings {
+    if crossings == Crossings::Allowed {
         note_crossings(&mesh, &name, common);
     }
     if !common.quiet && !common.json {
@@ -132,7 +166,7 @@ pub fn labelled_surface(
     labels: &[String],
     common: Common,
     stage: &Stage,
-    crossings: bool,
+    crossings: Crossings,
 ) -> Result<(SurfaceMesh, Vec<Shell>, String)> {
     let (s, shells, _, name) = labelled_surface_report(paths, labels, common, stage, crossings)?;
     Ok((s, shells, name))
@@ -145,7 +179,7 @@ pub fn labelled_surface_report(
     labels: &[String],
     common: Common,
     stage: &Stage,
-    crossings: bool,
+    crossings: Crossings,
 ) -> Result<(SurfaceMesh, Vec<Shell>, ValidationReport, String)> {
     let labels = parse_labels(labels, paths)?;
     let mut parts = Vec::new();
@@ -199,37 +233,30 @@ pub fn assemble_parts(
     paths: &[PathBuf],
     common: Common,
 ) -> Result<(SurfaceMesh, Vec<Shell>)> {
-    let (s, shells, _) = assemble_validated(parts, name, paths, common, false)?;
+    let (s, shells, _) = assemble_validated(parts, name, paths, common, Crossings::Refused)?;
     Ok((s, shells))
 }
 
-/// A validation error, with the way out added where triangles cross: the surface stage
-/// untangles them.
-fn crossing_hint(e: biotet::mesh::validate::SurfaceError) -> anyhow::Error {
-    if matches!(
-        e,
-        biotet::mesh::validate::SurfaceError::SelfIntersection { .. }
-    ) {
-        anyhow::Error::new(e).context(biotet::surface::untangle::HINT)
-    } else {
-        anyhow::Error::new(e)
-    }
-}
-
 /// A validation error as the user sees it. Where crossing triangles were let through (the
-/// surface stage follows) and the validation failed all the same, the crossings are the cause
-/// to name (shells pushed into one another also confuse their nesting); where they were not,
-/// a crossing's refusal says how the stage untangles them.
+/// surface stage follows) and the validation failed on the nesting all the same, the crossings
+/// are the cause to name (shells pushed into one another confuse it); any other failure is its
+/// own. Where they were refused with the hint, a crossing's refusal says how the stage
+/// untangles them.
 fn refusal(
     s: &SurfaceMesh,
     e: biotet::mesh::validate::SurfaceError,
-    crossings: bool,
+    crossings: Crossings,
 ) -> anyhow::Error {
-    if crossings {
-        let first = check_self_intersections(s, ValidateOptions::default().max_examples);
-        anyhow::Error::new(first.err().unwrap_or(e))
-    } else {
-        crossing_hint(e)
+    use biotet::mesh::validate::SurfaceError::{LabelsContradictGeometry, SelfIntersection};
+    match crossings {
+        Crossings::Allowed if matches!(e, LabelsContradictGeometry { .. }) => {
+            let first = check_self_intersections(s, ValidateOptions::default().max_examples);
+            anyhow::Error::new(first.err().unwrap_or(e))
+        }
+        Crossings::Hinted if matches!(e, SelfIntersection { .. }) => {
+            anyhow::Error::new(e).context(biotet::surface::untangle::HINT)
+        }
+        _ => anyhow::Error::new(e),
     }
 }
 
@@ -294,18 +321,18 @@ fn assemble_validated(
     name: &str,
     paths: &[PathBuf],
     common: Common,
-    crossings: bool,
+    crossings: Crossings,
 ) -> Result<(SurfaceMesh, Vec<Shell>, ValidationReport)> {
     let (mut surface, shells) =
         assemble(parts).with_context(|| format!("{name}: cannot assemble the surfaces"))?;
     let opts = ValidateOptions {
-        self_intersections: !crossings,
+        self_intersections: crossings != Crossings::Allowed,
         ..ValidateOptions::default()
     };
     let report = validate_surface(&mut surface, &opts)
         .map_err(|e| refusal(&surface, e, crossings))
         .with_context(|| format!("{name}: invalid surface"))?;
-    if crossings {
+    if crossings == Crossings::Allowed {
         note_crossings(&surface, name, common);
     }
     if !common.quiet && !common.json {
@@ -347,7 +374,9 @@ pub fn surfaces(paths: &[PathBuf], common: Common, stage: &Stage) -> Result<Opti
     if paths.is_empty() {
         return Ok(None);
     }
-    Ok(Some(labelled_surface(paths, &[], common, stage, false)?.0))
+    Ok(Some(
+        labelled_surface(paths, &[], common, stage, Crossings::Refused)?.0,
+    ))
 }
 
 /// The `n` comma-separated finite numbers of option `--what`'s value `text`.

@@ -235,7 +235,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
             &a.label,
             a.common,
             &stage,
-            a.surface_tolerance.is_some(),
+            super::input::Crossings::unless_staged(a.surface_tolerance.is_some()),
         )?
     };
     let seconds_read = clock.elapsed().as_secs_f64();

@@ -267,8 +267,13 @@ pub fn report_text(r: &SurfaceReport) -> String {
 
 fn run_improve(a: ImproveArgs) -> Result<ExitCode> {
     let stage_ = Stage::start(a.common.quiet, "reading the surface");
-    let (surface, _, name) =
-        super::input::labelled_surface(&a.surfaces, &a.label, a.common, &stage_, true)?;
+    let (surface, _, name) = super::input::labelled_surface(
+        &a.surfaces,
+        &a.label,
+        a.common,
+        &stage_,
+        super::input::Crossings::Allowed,
+    )?;
     stage_.set("improving the surface");
     let (out, report) = stage(
         &surface,

@@ -36,7 +36,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
             &[],
             a.common,
             &stage,
-            false,
+            super::input::Crossings::Hinted,
         )?;
         drop(stage);
         if !a.common.quiet && !a.common.json {

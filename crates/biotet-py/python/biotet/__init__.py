@@ -497,7 +497,8 @@ def mesh(
     the seeds in thin sections, polishing's; ``--no-steiner``); ``recover``/``improve``/``smooth``/``polish`` switch stages off.
     ``surface_tolerance=D`` first remeshes the surface within a two-sided Hausdorff distance D
     (``--surface-tolerance D``; reported in ``report["surface"]``): fewer slivers, the surface
-    no longer kept exactly; ``surface_feature_angle``, ``surface_rounds`` and ``adaptive_size``
+    no longer kept exactly; crossing triangles (a FreeSurfer surface's few) are untangled first,
+    points moved at most D/4 (``report["surface"]["untangled"]``); ``surface_feature_angle``, ``surface_rounds`` and ``adaptive_size``
     are that stage's ``--feature-angle``, ``--surface-rounds`` and ``--adaptive-size``. ``threads``: worker threads (default one per core, at most four a core; the result does
     not depend on it). ``progress``: called with each stage's name (default: the ``biotet``
     logger at level INFO); an exception it raises stops the call and is raised in its place, as

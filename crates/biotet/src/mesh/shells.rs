@@ -17,7 +17,9 @@
 //! into cells by their exact angular order around every edge; nested cells are resolved by exact
 //! point location; each bounded region gets a label. Solids that share a face, each given with
 //! its whole boundary in one welded file (an assembly saved as one STL), have that face twice
-//! with opposite orientations: one copy is kept, and the arrangement labels its two sides.
+//! with opposite orientations: one copy is kept, and the arrangement labels its two sides (the
+//! face triangulated alike by both; split along different diagonals, the copies overlap and are
+//! refused).
 //!
 //! Shells touching only along an edge (no shared triangle) make their part non-manifold: it is
 //! labelled from its arrangement, each shell its own region, the edge shared by them; shells
@@ -79,7 +81,7 @@ pub enum AssembleError {
     #[error("a non-manifold surface (more than two triangles at an edge) must be given alone")]
     NonManifoldWithOthers,
     /// The triangles do not split space into consistent cells: the edge where they do not,
-    /// by its points' indices (in the welded numbering) and coordinates.
+    /// by its points' indices (the part's numbering, welded for a soup) and coordinates.
     #[error(
         "the triangles around edge ({a}, {b}) {}–{} do not bound consistent regions (crossing \
          or overlapping triangles)",

@@ -197,9 +197,10 @@ pub struct SurfaceReport {
     /// Seconds of the first validation and measure.
     pub seconds_measure: f64,
     /// Crossing triangles in the input, untangled first ([`untangle`]): the stage then ran on
-    /// the untangled surface with the tolerance less its largest move, and the distances above
-    /// are to the untangled surface (the bounds include the move, so they bound the distance
-    /// to the input). `None` when nothing crossed.
+    /// the untangled surface with the tolerance less its largest move, and the figures above
+    /// that describe the input (distances, volumes, angles, folds, triangles, seconds by phase)
+    /// are the untangled surface's; the distance bounds include the move, so they bound the
+    /// distance to the input. `None` when nothing crossed.
     pub untangled: Option<untangle::Untangled>,
 }
 
@@ -369,7 +370,20 @@ pub fn improve_with_progress(
             orient_sheets: false,
             ..opts.clone()
         };
-        let (out, mut report) = improve_with_progress(&untangled, &inner, progress)?;
+        // Errors of the inner run in the caller's terms: its tolerance, distances to the input.
+        let (out, mut report) =
+            improve_with_progress(&untangled, &inner, progress).map_err(|e| match e {
+                SurfaceError::Tolerance {
+                    in_to_out,
+                    out_to_in,
+                    ..
+                } => SurfaceError::Tolerance {
+                    tolerance: d,
+                    in_to_out: in_to_out + u.max_move,
+                    out_to_in: out_to_in + u.max_move,
+                },
+                e => e,
+            })?;
         report.tolerance = d;
         report.hausdorff_bound += u.max_move;
         report.hausdorff_bound_in_to_out += u.max_move;

@@ -119,11 +119,27 @@ pub fn untangle(s: &SurfaceMesh, budget: f64) -> Result<(SurfaceMesh, Untangled)
                 q
             })
             .collect();
+        let mut changed = false;
         for (&v, q) in active.iter().zip(next) {
             if q != out.points[v as usize] {
                 out.points[v as usize] = q;
                 moved[v as usize] = true;
+                changed = true;
             }
+        }
+        if !changed {
+            // Every point held at its budget (or at its neighbours' centroid): on to a wider
+            // region, or, with none to come, further steps would change nothing.
+            if rings == MAX_RINGS {
+                return Err(UntangleError {
+                    pairs: report.pairs,
+                    left: pairs.len(),
+                    first: pairs[0],
+                    budget,
+                });
+            }
+            report.steps = rings * STEPS_PER_RING;
+            continue;
         }
         report.steps += 1;
         pairs = crossing_pairs(&out);
@@ -259,7 +275,7 @@ mod tests {
     }
 
     /// The slab with its top's middle point pushed down through the bottom.
-    pub(crate) fn poked_slab() -> SurfaceMesh {
+    fn poked_slab() -> SurfaceMesh {
         let mut s = slab();
         s.points[81 + 4 * 9 + 4][2] = -0.1;
         s
