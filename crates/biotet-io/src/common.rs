@@ -136,6 +136,24 @@ pub(crate) fn check_surface(m: &SurfaceMesh, file: &str) -> Result<()> {
     check_cells(&m.triangles, m.points.len(), "triangle", file)
 }
 
+/// A surface read from a format without labels, refs or polygons (FreeSurfer, GIfTI): checked
+/// (indices in range, finite coordinates), every triangle `[1, 0]`.
+pub(crate) fn plain_surface(
+    points: Vec<[f64; 3]>,
+    triangles: Vec<[u32; 3]>,
+    file: &str,
+) -> Result<crate::SurfaceRead> {
+    let mesh = SurfaceMesh::closed(points, triangles, 1);
+    check_surface(&mesh, file)?;
+    Ok(crate::SurfaceRead {
+        mesh,
+        triangle_refs: None,
+        side_labels: None,
+        welded: 0,
+        polygons_split: 0,
+    })
+}
+
 /// Validate a surface with its side labels before writing them: one pair a triangle (or none: a
 /// surface without labels), each label fitting a signed 32-bit integer (VTK's `Int32`).
 pub(crate) fn check_sided_surface(m: &SurfaceMesh, file: &str) -> Result<()> {

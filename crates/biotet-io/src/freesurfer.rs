@@ -17,7 +17,7 @@ use std::io::Write;
 use biotet::SurfaceMesh;
 
 use crate::SurfaceRead;
-use crate::common::check_surface;
+use crate::common::{check_surface, plain_surface};
 use crate::error::{Error, Result};
 use crate::limits;
 
@@ -110,15 +110,7 @@ pub fn parse(data: &[u8], file: &str) -> Result<SurfaceRead> {
         }
         triangles.push(t);
     }
-    let mesh = SurfaceMesh::closed(points, triangles, 1);
-    check_surface(&mesh, file)?;
-    Ok(SurfaceRead {
-        mesh,
-        triangle_refs: None,
-        side_labels: None,
-        welded: 0,
-        polygons_split: 0,
-    })
+    plain_surface(points, triangles, file)
 }
 
 /// Write a FreeSurfer triangle surface (coordinates rounded to `float32`; side labels are not

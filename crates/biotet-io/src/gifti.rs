@@ -16,7 +16,7 @@ use biotet::SurfaceMesh;
 
 use crate::SurfaceRead;
 use crate::b64;
-use crate::common::check_surface;
+use crate::common::{check_surface, plain_surface};
 use crate::error::{Error, Result};
 use crate::limits;
 use crate::text::{parse_f64, parse_i64, show};
@@ -93,15 +93,7 @@ pub fn parse(data: &[u8], file: &str) -> Result<SurfaceRead> {
         }
         tris.push(tri);
     }
-    let mesh = SurfaceMesh::closed(pts, tris, 1);
-    check_surface(&mesh, file)?;
-    Ok(SurfaceRead {
-        mesh,
-        triangle_refs: None,
-        side_labels: None,
-        welded: 0,
-        polygons_split: 0,
-    })
+    plain_surface(pts, tris, file)
 }
 
 /// Write a GIfTI surface: a `NIFTI_INTENT_POINTSET` array (`float64`) and a
