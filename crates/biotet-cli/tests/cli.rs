@@ -1750,6 +1750,11 @@ fn solids_sharing_a_face_in_one_stl_are_two_regions() {
     std::fs::write(&input, stl).unwrap();
     let v = biotet(&["validate", s(&input)]);
     assert!(v.status.success(), "{}", stderr(&v));
+    assert!(
+        stderr(&v).contains("2 triangles given twice"),
+        "{}",
+        stderr(&v)
+    );
     let out = dir.path().join("assembly.vtu");
     let j = json_of(&biotet(&["mesh", s(&input), "-o", s(&out), "--json"]));
     assert_eq!(j["quality"]["n_regions"], 2, "{j}");

@@ -323,8 +323,18 @@ fn assemble_validated(
     common: Common,
     crossings: Crossings,
 ) -> Result<(SurfaceMesh, Vec<Shell>, ValidationReport)> {
+    let given: usize = parts.iter().map(|p| p.surface.triangles.len()).sum();
     let (mut surface, shells) =
         assemble(parts).with_context(|| format!("{name}: cannot assemble the surfaces"))?;
+    // Shared faces (touching shells, solids of one assembly) come once in each boundary and
+    // are kept once: the user hears why the count fell.
+    let shared = given.saturating_sub(surface.triangles.len());
+    if shared > 0 && !common.quiet && !common.json {
+        eprintln!(
+            "note: {name}: {shared} triangles given twice (once in each of two touching \
+             boundaries) are kept once, as interfaces"
+        );
+    }
     let opts = ValidateOptions {
         self_intersections: crossings != Crossings::Allowed,
         ..ValidateOptions::default()
