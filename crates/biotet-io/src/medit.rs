@@ -42,6 +42,7 @@ use std::io::{BufRead, Write};
 
 use biotet::mesh::coord_key;
 use biotet::mesh::side_labels::FROM_GEOMETRY;
+use biotet::mesh::surface::same_turn;
 use biotet::{SurfaceMesh, TetMesh, TriMesh};
 
 use crate::common::{
@@ -298,9 +299,7 @@ fn sides_from_refs(
             }
             Some(&k) => {
                 let i = origin[k];
-                let a = canon(&kept[k]);
-                let same = (0..3).any(|s| [a[s], a[(s + 1) % 3], a[(s + 2) % 3]] == c);
-                if same {
+                if same_turn(canon(&kept[k]), c) {
                     return Err(err(format!(
                         "repeats triangle {i} with the same orientation; a triangle between two \
                          regions is given once, or twice with opposite orientations (once in \

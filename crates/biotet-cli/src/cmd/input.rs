@@ -71,10 +71,7 @@ pub fn side_labelled(
     let mut mesh = read.mesh;
     mesh.sides = read.side_labels.unwrap_or_default();
     // Copies of a point that differ only by index are one point, as in `assemble`.
-    let welded = mesh.weld_exact();
-    if welded > 0 && !common.quiet && !common.json {
-        eprintln!("note: {name}: welded {welded} duplicate vertices");
-    }
+    note_welded(&name, mesh.weld_exact(), common);
     let partial = mesh.sides.iter().flatten().any(|&l| l == FROM_GEOMETRY);
     let invalid = || format!("{name}: invalid surface");
     let opts = ValidateOptions {
@@ -208,9 +205,7 @@ pub fn labelled_surface_report(
         // `assemble` welds copies of a point in every format, as the STL reader does: the user
         // hears how many.
         let welded = read.welded + read.mesh.duplicate_points();
-        if welded > 0 && !common.quiet && !common.json {
-            eprintln!("note: {}: welded {welded} duplicate vertices", p.display());
-        }
+        note_welded(&p.display().to_string(), welded, common);
         parts.push(Part {
             surface: read.mesh,
             labels: labels[i].clone(),
@@ -257,6 +252,14 @@ fn refusal(
             anyhow::Error::new(e).context(biotet::surface::untangle::HINT)
         }
         _ => anyhow::Error::new(e),
+    }
+}
+
+/// Tell the user how many copies of points were welded (a triangle soup is the surface it
+/// describes).
+pub fn note_welded(name: &str, welded: usize, common: Common) {
+    if welded > 0 && !common.quiet && !common.json {
+        eprintln!("note: {name}: welded {welded} duplicate vertices");
     }
 }
 

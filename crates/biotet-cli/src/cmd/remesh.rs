@@ -198,12 +198,7 @@ pub fn run(a: Args) -> Result<ExitCode> {
             let mut surface = biotet_io::read_surface(path)?.mesh;
             // A soup is the surface it describes, as for `biotet mesh`.
             let welded = surface.weld_exact();
-            if welded > 0 && !a.common.quiet && !a.common.json {
-                eprintln!(
-                    "note: {}: welded {welded} duplicate vertices",
-                    path.display()
-                );
-            }
+            super::input::note_welded(&path.display().to_string(), welded, a.common);
             let label = a.label.unwrap_or(0);
             let margin = a.margin.unwrap_or(match a.size {
                 Some(h) => h,

@@ -34,7 +34,7 @@ use rustc_hash::FxHashMap;
 use crate::geom::vec3::volume6;
 use crate::mesh::coord_key;
 use crate::mesh::inside::{Location, RegionLocator};
-use crate::mesh::surface::SurfaceMesh;
+use crate::mesh::surface::{SurfaceMesh, same_turn};
 
 /// One shell of an assembled surface.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -266,9 +266,7 @@ fn merge_opposite_copies(mut s: SurfaceMesh) -> SurfaceMesh {
         let mut key = *tri;
         key.sort_unstable();
         if let Some(&f) = open.get(&key) {
-            let a = s.triangles[f];
-            let same = (0..3).any(|r| [a[r], a[(r + 1) % 3], a[(r + 2) % 3]] == *tri);
-            if !same {
+            if !same_turn(s.triangles[f], *tri) {
                 drop[t] = true;
                 open.remove(&key);
             }

@@ -17,6 +17,12 @@ pub struct SurfaceMesh {
     pub sides: Vec<[u32; 2]>,
 }
 
+/// Whether `b` is triangle `a` with the same orientation (a rotation of its corners); `false`
+/// for the reversed triangle and for other corners.
+pub fn same_turn(a: [u32; 3], b: [u32; 3]) -> bool {
+    (0..3).any(|r| [a[r], a[(r + 1) % 3], a[(r + 2) % 3]] == b)
+}
+
 impl SurfaceMesh {
     /// An icosphere of radius `r` centred at the origin: the icosahedron, `levels` times split
     /// into four, its points pushed onto the sphere at the end; outward, one region (label 1).

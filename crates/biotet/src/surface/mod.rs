@@ -361,10 +361,11 @@ pub fn improve_with_progress(
     }
     // Crossing triangles (a FreeSurfer surface's few): untangled within a share of the
     // tolerance, the rest of it left to the remeshing, so the output stays within D of the input.
-    if !validate::crossing_pairs(&input).is_empty() {
-        progress("untangling crossing triangles");
-        let (untangled, u) =
-            untangle::untangle(&input, UNTANGLE_SHARE * d).map_err(SurfaceError::Crossings)?;
+    // One crossing test: `untangle` returns the surface as it is when nothing crosses.
+    progress("crossing triangles");
+    let (untangled, u) =
+        untangle::untangle(&input, UNTANGLE_SHARE * d).map_err(SurfaceError::Crossings)?;
+    if u.pairs > 0 {
         let inner = SurfaceOptions {
             tolerance: d - u.max_move,
             orient_sheets: false,
@@ -392,6 +393,7 @@ pub fn improve_with_progress(
         report.untangled = Some(u);
         return Ok((out, report));
     }
+    drop(untangled);
     let surface = &input;
     let l = match opts.edge_length {
         Some(h) if h.is_finite() && h > 0.0 => h,
