@@ -362,10 +362,10 @@ pub fn improve_with_progress(
     // Crossing triangles (a FreeSurfer surface's few): untangled within a share of the
     // tolerance, the rest of it left to the remeshing, so the output stays within D of the input.
     // One crossing test: `untangle` returns the surface as it is when nothing crosses.
-    progress("crossing triangles");
     let (untangled, u) =
         untangle::untangle(&input, UNTANGLE_SHARE * d).map_err(SurfaceError::Crossings)?;
     if u.pairs > 0 {
+        progress("untangled crossing triangles");
         let inner = SurfaceOptions {
             tolerance: d - u.max_move,
             orient_sheets: false,
